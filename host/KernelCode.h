@@ -1,0 +1,14 @@
+#pragma once
+// The kernels' shared functions (kernels/*.h) compiled as C++ in namespace
+// misalloc::kern: host references, tests and the OpenMP benchmark peer call exactly
+// the maths that the OpenCL kernels run.
+#include <Random123/philox.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace misalloc::kern {
+#include "estimator.h"
+#include "pixel.h"
+}  // namespace misalloc::kern

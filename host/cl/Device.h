@@ -1,0 +1,34 @@
+#pragma once
+#include <CL/opencl.hpp>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace misalloc {
+
+// One OpenCL device with its context and an in-order, profiling queue.
+struct Device {
+  cl::Platform platform;
+  cl::Device device;
+  cl::Context context;
+  cl::CommandQueue queue;
+
+  std::string name() const;
+  bool isGpu() const;
+};
+
+// Every device of every platform, in the order `misalloc devices` lists them.
+std::vector<std::pair<cl::Platform, cl::Device>> enumerateDevices();
+
+void listDevices(std::ostream& out);
+
+// spec: "" or "auto" (the first GPU, else the first CPU), "cpu", "gpu", or an index
+// into enumerateDevices(). Throws DeviceError with install advice if there is no
+// OpenCL platform, InputError for a spec that matches nothing.
+Device openDevice(const std::string& spec);
+
+// Builds `mainFile` (an embedded kernel source) with `options`; a failure throws
+// DeviceError carrying the build log.
+cl::Program buildProgram(const Device& device, const std::string& mainFile, const std::string& options);
+
+}  // namespace misalloc

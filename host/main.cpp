@@ -1,0 +1,180 @@
+// misalloc: per-pixel MIS sample allocation for envmap × BRDF direct lighting.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+
+#include "AtomicFile.h"
+#include "Error.h"
+#include "cl/Device.h"
+#include "render/ImageMetrics.h"
+#include "render/Method.h"
+#include "render/Reference.h"
+#include "render/Render.h"
+#include "render/Report.h"
+#include "render/Sampler.h"
+
+using namespace misalloc;
+
+namespace {
+
+struct SceneArgs {
+  SceneOptions options;
+  std::string size = "128x128", view = "0", sampler = "alias";
+
+  void add(CLI::App* app) {
+    app->add_option("--envmap", options.envmap,
+                    "EXR path, shipped map name (forest_slope, rooitou_park, ...), constant[:R], cosk:K or "
+                    "sun[:THETA,PHI,RADIUS,RATIO]")
+        ->capture_default_str();
+    app->add_option("--grid", options.grid, "seed000, general:RD0,RD1,N0,N1 or uniform:RD,RS,N")->capture_default_str();
+    app->add_option("--size", size, "WxH pixels")->capture_default_str();
+    app->add_option("--view", view, "view direction: polar angle THETA[,PHI] in degrees")->capture_default_str();
+    app->add_flag("--split-brdf", options.splitBrdf, "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
+    app->add_option("--envmap-sampler", sampler, "alias (O(1)) or cdf (two binary searches)")->capture_default_str();
+    app->add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
+        ->capture_default_str();
+  }
+
+  Scene make() {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w <= 0 || h <= 0)
+      throw InputError(fmt::format("--size {}: expected WxH with W, H ≥ 1", size));
+    options.width = w;
+    options.height = h;
+    double theta = 0, phi = 0;
+    int n = std::sscanf(view.c_str(), "%lf,%lf%c", &theta, &phi, &extra);
+    if (n < 1 || n > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
+    options.viewTheta = theta;
+    options.viewPhi = phi;
+    options.sampler = parseEnvmapSampler(sampler);
+    return makeScene(options);
+  }
+};
+
+std::unique_ptr<StageSampler> makeSampler(const std::string& deviceSpec, std::unique_ptr<Device>& device,
+                                          const Scene& scene, Estimator estimator, int localSize) {
+  if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, estimator);
+  device = std::make_unique<Device>(openDevice(deviceSpec));
+  return std::make_unique<Sampler>(*device, scene, estimator, localSize);
+}
+
+Estimator parseEstimator(const std::string& name) {
+  if (name == "multi") return Estimator::MultiSample;
+  if (name == "one") return Estimator::OneSample;
+  throw InputError(fmt::format("--estimator '{}': expected multi or one", name));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"misalloc: per-pixel allocation of MIS samples for envmap x BRDF direct lighting"};
+  app.require_subcommand(1);
+  // A repeated option takes its last value, as in most command-line tools.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+
+  app.add_subcommand("devices", "list OpenCL platforms and devices");
+
+  auto* renderCmd = app.add_subcommand("render", "render a scene (default: forest_slope x seed000, 128x128, 200 spp)");
+  SceneArgs renderScene;
+  renderScene.add(renderCmd);
+  int spp = 200, localSize = 8, referenceSpp = 16384;
+  uint64_t seed = 1;
+  std::string method = "equal", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
+              reportPath = "render.json", referenceMode = "auto", cacheDir = defaultCacheDir();
+  renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str();
+  renderCmd->add_option("--method", method, "envmap, brdf or equal")->capture_default_str();
+  renderCmd->add_option("--estimator", estimatorName, "multi (000 eq. 4.1) or one (one-sample MIS)")
+      ->capture_default_str();
+  renderCmd->add_option("--seed", seed, "random seed")->capture_default_str();
+  renderCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, an index from `misalloc devices`, or host (C++)")
+      ->capture_default_str();
+  renderCmd->add_option("--out", out, "output EXR")->capture_default_str();
+  renderCmd->add_option("--report", reportPath, "output JSON report")->capture_default_str();
+  renderCmd->add_option("--reference", referenceMode,
+                        "auto (analytic, cached, or computed and cached), none, or an EXR path")
+      ->capture_default_str();
+  renderCmd->add_option("--reference-spp", referenceSpp, "spp of a sampled reference")->capture_default_str();
+  renderCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
+  renderCmd->add_option("--local-size", localSize, "OpenCL work-group size")->capture_default_str();
+
+  auto* referenceCmd = app.add_subcommand("reference", "compute (or find in the cache) a converged reference image");
+  SceneArgs referenceScene;
+  referenceScene.add(referenceCmd);
+  std::string referenceOut;
+  referenceCmd->add_option("--spp", referenceSpp, "samples per pixel")->capture_default_str();
+  referenceCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, index or host")->capture_default_str();
+  referenceCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
+  referenceCmd->add_option("--out", referenceOut, "also write the reference to this EXR");
+
+  auto* paperCmd = app.add_subcommand("paper", "the papers' 1D examples: list them, or print one against the papers");
+  std::string paperId;
+  paperCmd->add_option("id", paperId, "example id (see `misalloc paper`)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    if (app.got_subcommand("devices")) {
+      listDevices(std::cout);
+    } else if (app.got_subcommand("paper")) {
+      throw InputError("paper: pending");
+    } else if (app.got_subcommand("render")) {
+      if (spp < 1) throw InputError(fmt::format("--spp {}: need at least 1 sample per pixel", spp));
+      Method m = parseMethod(method);
+      Estimator estimator = parseEstimator(estimatorName);
+      checkWritableOutput(out, "--out");
+      checkWritableOutput(reportPath, "--report");
+      Scene scene = renderScene.make();
+      std::unique_ptr<Device> device;
+      auto sampler = makeSampler(deviceSpec, device, scene, estimator, localSize);
+      std::string deviceName = device ? device->name() : "host (C++ reference, OpenMP)";
+      std::optional<Reference> reference;
+      if (referenceMode == "auto")
+        reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
+      else if (referenceMode != "none")
+        reference = Reference{readExr(referenceMode), "file", referenceMode};
+      if (reference) checkSameSize(reference->image, RgbImage{scene.grid.width, scene.grid.height, {}});
+      Rendering r = render(*sampler, scene, m, estimator, spp, seed);
+      nlohmann::json report = renderReport({scene, m, estimator, spp, seed, deviceName, r, reference});
+      writeExr(out, r.image);
+      writeFileAtomically(reportPath, report.dump(2) + "\n");
+      std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s)\n", deviceName,
+                               scene.options.envmap, scene.options.grid, scene.grid.width, scene.grid.height, spp,
+                               methodName(m), r.wallSeconds, r.kernelSeconds);
+      if (reference)
+        std::cout << fmt::format("RMSE x1000 {:.3f}, relative MSE {:.4g} (reference: {})\n",
+                                 report["rmse_x1000"].get<double>(), report["relative_mse"].get<double>(),
+                                 reference->source);
+      std::cout << fmt::format("wrote {} and {}\n", out, reportPath);
+    } else if (app.got_subcommand("reference")) {
+      if (referenceSpp < 1) throw InputError("--spp must be at least 1");
+      if (!referenceOut.empty()) checkWritableOutput(referenceOut, "--out");
+      Scene scene = referenceScene.make();
+      std::unique_ptr<Device> device;
+      auto sampler = makeSampler(deviceSpec, device, scene, Estimator::MultiSample, localSize);
+      auto reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
+      if (!referenceOut.empty()) writeExr(referenceOut, reference->image);
+      std::cout << fmt::format("reference: {}{}\n", reference->source,
+                               reference->path.empty() ? "" : " at " + reference->path);
+    }
+  } catch (const InputError& e) {
+    std::cerr << "misalloc: error: " << e.what() << "\n";
+    return 2;
+  } catch (const DeviceError& e) {
+    std::cerr << "misalloc: OpenCL error: " << e.what() << "\n";
+    return 3;
+  } catch (const cl::Error& e) {
+    std::cerr << "misalloc: OpenCL error: " << e.what() << " (code " << e.err() << ")\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "misalloc: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,72 @@
+// HostSampler: the C++ reference of kernels/sample.cl, through host/KernelCode.h.
+#include <algorithm>
+#include <chrono>
+
+#include "KernelCode.h"
+#include "render/KernelViews.h"
+#include "render/Sampler.h"
+
+namespace misalloc {
+
+kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
+  kern::EnvmapView env;
+  env.texels = t.texels.data();
+  env.samplerTable = t.samplerTable.data();
+  env.aliasIndex = t.aliasIndex.data();
+  env.width = t.width;
+  env.height = t.height;
+  env.useCdf = t.useCdf ? 1 : 0;
+  env.cdfStepsRow = t.cdfStepsRow;
+  env.cdfStepsCol = t.cdfStepsCol;
+  env.coskExponent = coskExponent;
+  return env;
+}
+
+StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
+  const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
+  kern::EnvmapView env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
+  kern::TechniqueSet ts;
+  ts.techniqueCount = M;
+  ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
+  ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
+  const int oneSample = estimator_ == Estimator::OneSample ? 1 : 0;
+  StageResult result;
+  result.rgb.assign(size_t(pixels) * 3, 0.0);
+  result.moments.assign(size_t(pixels) * M * 2, 0.0);
+  auto start = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int pixel = 0; pixel < pixels; ++pixel) {
+    const PhongParameters& p = scene_.grid.pixels[pixel];
+    kern::PhongParams b;
+    b.rhoD = p.rhoD;
+    b.rhoS = p.rhoS;
+    b.n = p.n;
+    const int32_t* n = plan.counts.data() + size_t(pixel) * M;
+    const uint32_t* first = plan.firstIndex.data() + size_t(pixel) * M;
+    kern::StageCounts c;
+    c.techniqueCount = M;
+    c.stageSamples = plan.stageSamples;
+    c.oneSample = oneSample;
+    c.n0 = n[0];
+    c.n1 = n[1];
+    c.n2 = M > 2 ? n[M - 1] : 0;
+    c.first0 = first[0];
+    c.first1 = first[1];
+    c.first2 = M > 2 ? first[M - 1] : 0u;
+    kern::PixelSums sums = kern::zeroPixelSums();
+    for (int j = 0; j < plan.stageSamples; ++j)
+      kern::addContribution(&sums, kern::takeStageSample(ts, env, b, c, j, uint32_t(seed), uint32_t(seed >> 32),
+                                                         uint32_t(pixel)));
+    double* rgb = result.rgb.data() + size_t(pixel) * 3;
+    rgb[0] = sums.r;
+    rgb[1] = sums.g;
+    rgb[2] = sums.b;
+    double* m = result.moments.data() + size_t(pixel) * M * 2;
+    const double moments[6] = {sums.w0, sums.ww0, sums.w1, sums.ww1, sums.w2, sums.ww2};
+    std::copy(moments, moments + 2 * M, m);
+  }
+  result.kernelSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace misalloc

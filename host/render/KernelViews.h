@@ -1,0 +1,10 @@
+#pragma once
+// Host data seen through the kernels' own structs (host/KernelCode.h).
+#include "KernelCode.h"
+#include "scene/EnvmapDistribution.h"
+
+namespace misalloc {
+
+kern::EnvmapView makeEnvmapView(const EnvmapTables& tables, float coskExponent);
+
+}  // namespace misalloc

@@ -1,0 +1,103 @@
+#include "render/Reference.h"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "render/Method.h"
+
+namespace misalloc {
+namespace fs = std::filesystem;
+namespace {
+
+// FNV-1a, 64 bits: a stable content hash for cache keys.
+struct Fnv1a {
+  uint64_t h = 0xcbf29ce484222325ull;
+  void add(const void* data, size_t n) {
+    auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  }
+  void add(const std::string& s) { add(s.data(), s.size() + 1); }
+  template <typename T>
+  void addValue(T v) { add(&v, sizeof v); }
+};
+
+}  // namespace
+
+std::optional<RgbImage> analyticReference(const Scene& scene) {
+  const float K = scene.envmap.coskExponent;
+  if (K < 0 || scene.options.viewTheta != 0) return std::nullopt;
+  RgbImage image;
+  image.width = scene.grid.width;
+  image.height = scene.grid.height;
+  image.rgb.reserve(scene.grid.pixels.size() * 3);
+  for (const auto& p : scene.grid.pixels) {
+    double L = 2.0 * p.rhoD / (K + 2.0) + double(p.rhoS) * (p.n + 2.0) / (p.n + K + 2.0);  // 000 eq. 6.17
+    for (int c = 0; c < 3; ++c) image.rgb.push_back(float(L));
+  }
+  return image;
+}
+
+RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed) {
+  constexpr int maxStage = 4096;
+  const int pixels = scene.pixelCount(), M = scene.techniqueCount();
+  std::vector<double> sum(size_t(pixels) * 3, 0.0);
+  StagePlan plan = singleStagePlan(scene, Method::Equal, std::min(spp, maxStage));
+  for (int done = 0; done < spp;) {
+    int n = std::min(maxStage, spp - done);
+    if (n != plan.stageSamples) plan = singleStagePlan(scene, Method::Equal, n);
+    for (int p = 0; p < pixels; ++p)
+      for (int k = 0; k < M; ++k) plan.firstIndex[size_t(p) * M + k] = uint32_t(done / M + (k < done % M ? 1 : 0));
+    StageResult stage = sampler.run(plan, seed);
+    // Each stage is an unbiased estimate; weighting by its share of the samples keeps
+    // the average unbiased and gives every sample the same weight.
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += stage.rgb[i] * n / spp;
+    done += n;
+  }
+  RgbImage image;
+  image.width = scene.grid.width;
+  image.height = scene.grid.height;
+  image.rgb.assign(sum.begin(), sum.end());
+  return image;
+}
+
+std::string referenceKey(const Scene& scene, int spp) {
+  Fnv1a h;
+  const RgbImage& env = scene.envmap.image;
+  h.addValue(env.width);
+  h.addValue(env.height);
+  h.add(env.rgb.data(), env.rgb.size() * sizeof(float));
+  h.addValue(scene.envmap.coskExponent);
+  h.add(scene.grid.spec);
+  h.addValue(scene.grid.width);
+  h.addValue(scene.grid.height);
+  h.addValue(scene.options.viewTheta);
+  h.addValue(scene.options.viewPhi);
+  h.addValue(spp);
+  return fmt::format("{:016x}", h.h);
+}
+
+std::string defaultCacheDir() {
+  if (const char* dir = std::getenv("MISALLOC_CACHE_DIR")) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME")) return fmt::format("{}/misalloc", xdg);
+  if (const char* home = std::getenv("HOME")) return fmt::format("{}/.cache/misalloc", home);
+  return ".cache/misalloc";
+}
+
+std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
+                                       bool computeIfMissing) {
+  if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic (000 eq. 6.17)", ""};
+  fs::path path = fs::path(cacheDir) / "references" / (referenceKey(scene, spp) + ".exr");
+  std::string source = fmt::format("equal-count MIS, {} spp", spp);
+  if (fs::exists(path)) return Reference{readExr(path.string()), source + " (cached)", path.string()};
+  if (!computeIfMissing) return std::nullopt;
+  // A seed of its own (top bit set), so a render with a small seed is independent of it.
+  RgbImage image = sampleReference(sampler, scene, spp, 0x8000000000005eedull);
+  fs::create_directories(path.parent_path());
+  writeExr(path.string(), image);
+  return Reference{image, source, path.string()};
+}
+
+}  // namespace misalloc

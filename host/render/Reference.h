@@ -1,0 +1,38 @@
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "render/Sampler.h"
+#include "scene/ExrIO.h"
+
+namespace misalloc {
+
+struct Reference {
+  RgbImage image;
+  std::string source;  // "analytic (000 eq. 6.17)", or how it was sampled
+  std::string path;    // the cached file, if any
+};
+
+// 000 eq. 6.17: for R = cos^K θ and ω_o along the normal, L = R(2ρd/(K+2) +
+// ρs(n+2)/(n+K+2)), exact. Empty for any other scene.
+std::optional<RgbImage> analyticReference(const Scene& scene);
+
+// A converged image: equal-count MIS with `spp` samples per pixel, taken in stages of
+// at most 4096 so that no kernel launch runs for long.
+RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed);
+
+// The cache key of a scene's reference: everything the pixel values depend on (the
+// envmap's texels, the analytic exponent, the grid, size and view) and the spp, not
+// the techniques or the sampler.
+std::string referenceKey(const Scene& scene, int spp);
+
+// $MISALLOC_CACHE_DIR, else $XDG_CACHE_HOME/misalloc, else ~/.cache/misalloc.
+std::string defaultCacheDir();
+
+// The analytic reference if there is one, else the cached one, else (when
+// `computeIfMissing`) a sampled one, which is then cached.
+std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
+                                       bool computeIfMissing);
+
+}  // namespace misalloc

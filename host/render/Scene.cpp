@@ -1,0 +1,57 @@
+#include "render/Scene.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "Error.h"
+
+namespace misalloc {
+namespace fs = std::filesystem;
+
+std::vector<std::string> Scene::techniqueNames() const {
+  if (options.splitBrdf) return {"envmap", "diffuse", "specular"};
+  return {"envmap", "brdf"};
+}
+
+std::string resolveEnvmapSpec(const std::string& spec) {
+  for (const char* procedural : {"constant", "cosk", "sun"})
+    if (spec == procedural || spec.rfind(std::string(procedural) + ":", 0) == 0) return spec;
+  if (fs::exists(spec) || spec.find('/') != std::string::npos || spec.find(".exr") != std::string::npos) return spec;
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("MISALLOC_DATA_DIR")) dirs.push_back(fmt::format("{}/envmaps", env));
+  dirs.push_back(MISALLOC_INSTALL_DATA_DIR "/envmaps");
+  dirs.push_back(MISALLOC_SOURCE_DIR "/data/envmaps");
+  for (const auto& dir : dirs) {
+    fs::path candidate = fs::path(dir) / (spec + ".exr");
+    if (fs::exists(candidate)) return candidate.string();
+  }
+  throw InputError(fmt::format("--envmap '{}': no such file, and no shipped map of that name in {}", spec,
+                               fmt::join(dirs, ", ")));
+}
+
+EnvmapSampler parseEnvmapSampler(const std::string& name) {
+  if (name == "alias") return EnvmapSampler::Alias;
+  if (name == "cdf") return EnvmapSampler::Cdf;
+  throw InputError(fmt::format("--envmap-sampler '{}': expected alias or cdf", name));
+}
+
+Scene makeScene(const SceneOptions& options) {
+  if (!(options.viewTheta >= 0 && options.viewTheta < 90))
+    throw InputError(fmt::format("--view {}: the view's polar angle must lie in [0, 90) degrees", options.viewTheta));
+  Scene scene;
+  scene.options = options;
+  scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
+  std::string resolved = resolveEnvmapSpec(options.envmap);
+  if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
+  scene.envmap = makeEnvmap(resolved, options.proceduralWidth);
+  scene.tables = buildEnvmapTables(scene.envmap, options.sampler);
+  double t = options.viewTheta * M_PI / 180, p = options.viewPhi * M_PI / 180;
+  // ω_r = 2(n·ω_o)n − ω_o with n = z.
+  scene.mirror = {float(-std::sin(t) * std::cos(p)), float(-std::sin(t) * std::sin(p)), float(std::cos(t))};
+  return scene;
+}
+
+}  // namespace misalloc

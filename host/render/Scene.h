@@ -1,0 +1,45 @@
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "scene/BrdfGrid.h"
+#include "scene/Envmap.h"
+#include "scene/EnvmapDistribution.h"
+
+namespace misalloc {
+
+struct SceneOptions {
+  std::string envmap = "forest_slope";  // a path, a shipped map's name, or a procedural spec
+  std::string grid = "seed000";
+  int width = 128, height = 128;
+  double viewTheta = 0, viewPhi = 0;  // ω_o in degrees; the normal is z
+  bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
+  EnvmapSampler sampler = EnvmapSampler::Alias;
+  int proceduralWidth = 512;
+};
+
+// Everything the sampling kernel reads, built once per run.
+struct Scene {
+  SceneOptions options;
+  std::string envmapPath;  // the resolved file, empty for procedural maps
+  Envmap envmap;
+  EnvmapTables tables;
+  BrdfGrid grid;
+  std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
+
+  int techniqueCount() const { return options.splitBrdf ? 3 : 2; }
+  int pixelCount() const { return grid.width * grid.height; }
+  std::vector<std::string> techniqueNames() const;
+};
+
+Scene makeScene(const SceneOptions& options);
+
+// A shipped map's name ("forest_slope") or a path to an EXR; procedural specs
+// (constant, cosk:K, sun...) are returned unchanged. Throws InputError naming the
+// places searched when a name matches no file.
+std::string resolveEnvmapSpec(const std::string& spec);
+
+EnvmapSampler parseEnvmapSampler(const std::string& name);
+
+}  // namespace misalloc

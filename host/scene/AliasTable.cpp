@@ -1,0 +1,57 @@
+#include "scene/AliasTable.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace misalloc {
+
+AliasTable buildAliasTable(std::vector<double> weights) {
+  const std::size_t n = weights.size();
+  if (n == 0 || n > std::numeric_limits<uint32_t>::max())
+    throw std::invalid_argument("an alias table needs between 1 and 2^32 - 1 weights");
+  double total = 0;
+  for (double w : weights) {
+    if (!(w >= 0) || !std::isfinite(w)) throw std::invalid_argument("alias table weights must be finite and >= 0");
+    total += w;
+  }
+  if (!(total > 0) || !std::isfinite(total)) throw std::invalid_argument("alias table weights must have a finite, positive sum");
+
+  // q_i = N p_i: bucket i keeps q_i of its unit of mass and lends the rest to its alias.
+  // w / total ≤ 1 cannot overflow, whatever the weights' scale.
+  std::vector<double>& q = weights;
+  for (double& w : q) w = w / total * double(n);
+
+  // Buckets of weight 0 go on top of the `under` stack so they are paired first, while
+  // `over` still holds a surplus of at least one unit per remaining zero. Pairing a
+  // zero, q_l − 1, is exact in double; until the zeros run out the only rounding comes
+  // from the at most one positive pairing per large bucket, far below a unit. So
+  // every zero gets probability 0 and a positive alias instead of being left over.
+  std::vector<uint32_t> under, over;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (q[i] >= 1) over.push_back(i);
+    else if (q[i] > 0) under.push_back(i);
+  }
+  for (uint32_t i = 0; i < n; ++i)
+    if (q[i] == 0) under.push_back(i);
+
+  AliasTable table{std::vector<float>(n), std::vector<uint32_t>(n)};
+  while (!under.empty() && !over.empty()) {
+    uint32_t small = under.back(), large = over.back();
+    under.pop_back();
+    table.probability[small] = float(q[small]);
+    table.alias[small] = large;
+    // (q_l + q_s) − 1 rounds once on the sum instead of on 1 − q_s as well.
+    q[large] = (q[large] + q[small]) - 1;
+    if (q[large] < 1) {
+      over.pop_back();
+      under.push_back(large);
+    }
+  }
+  // What is left has q = 1 up to rounding: accept always.
+  for (uint32_t i : under) table.probability[i] = 1, table.alias[i] = i;
+  for (uint32_t i : over) table.probability[i] = 1, table.alias[i] = i;
+  return table;
+}
+
+}  // namespace misalloc

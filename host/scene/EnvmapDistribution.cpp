@@ -1,0 +1,134 @@
+#include "scene/EnvmapDistribution.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+#include "Error.h"
+#include "scene/AliasTable.h"
+
+namespace misalloc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
+
+void requireKernelAddressable(const Envmap& envmap) {
+  const RgbImage& image = envmap.image;
+  if (image.width < 1 || image.height < 1 ||
+      image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
+    throw std::invalid_argument(fmt::format("envmap '{}' has {}×{} texels and {} floats", envmap.description,
+                                            image.width, image.height, image.rgb.size()));
+  // kernels/envmap.h indexes the texels as int 4·t.
+  if (int64_t(image.width) * image.height * 4 > INT_MAX)
+    throw InputError(fmt::format("envmap '{}' has {}×{} texels, too many for the kernels' 32-bit indices "
+                                 "(at most {} texels)", envmap.description, image.width, image.height, INT_MAX / 4));
+}
+
+// Luminance × sin θ at the texel centre: p(ω) = P W H / (2π² sin θ) inside a texel,
+// so this makes the solid-angle pdf ∝ luminance up to the variation of sin θ across it.
+std::vector<double> luminanceWeights(const RgbImage& image) {
+  std::vector<double> weights(std::size_t(image.width) * std::size_t(image.height));
+  for (int row = 0; row < image.height; ++row) {
+    double sinTheta = sinThetaOfRow(row, image.height);
+    for (int col = 0; col < image.width; ++col) {
+      std::size_t t = std::size_t(row) * std::size_t(image.width) + std::size_t(col);
+      double r = image.rgb[3 * t], g = image.rgb[3 * t + 1], b = image.rgb[3 * t + 2];
+      if (!(r >= 0 && g >= 0 && b >= 0) || !std::isfinite(r + g + b))
+        throw std::invalid_argument(fmt::format("envmap texel ({}, {}) is negative or not finite", col, row));
+      weights[t] = (0.2126 * r + 0.7152 * g + 0.0722 * b) * sinTheta;
+    }
+  }
+  return weights;
+}
+
+// sin θ alone: uniform over the sphere.
+std::vector<double> sphereWeights(int width, int height) {
+  std::vector<double> weights(std::size_t(width) * std::size_t(height));
+  for (int row = 0; row < height; ++row)
+    std::fill_n(weights.begin() + std::ptrdiff_t(row) * width, width, sinThetaOfRow(row, height));
+  return weights;
+}
+
+// cdf[0] = 0, cdf[i] = Σ_{k<i} w_k / Σ w, cdf[n] = 1. The prefix sums run in the same
+// order as the total, so after the last positive weight they equal it and the ratio
+// is exactly 1: searchCdf, which picks the last i with cdf[i] ≤ u < 1, then never
+// lands on a trailing zero, and a zero weight in between has cdf[i] = cdf[i+1]. A
+// total of 0 (a black row, never drawn) gets a uniform CDF so the table stays valid.
+void writeCdf(const double* weights, int n, float* cdf) {
+  double total = 0;
+  for (int i = 0; i < n; ++i) total += weights[i];
+  double prefix = 0;
+  cdf[0] = 0;
+  for (int i = 1; i < n; ++i) {
+    prefix += weights[i - 1];
+    cdf[i] = float(total > 0 ? prefix / total : double(i) / n);
+  }
+  cdf[n] = 1;
+}
+
+// The marginal CDF over rows, then each row's conditional CDF over its columns.
+std::vector<float> cdfTables(const std::vector<double>& weights, int width, int height) {
+  std::vector<float> table(std::size_t(height + 1) + std::size_t(height) * std::size_t(width + 1));
+  std::vector<double> rowWeights(height, 0.0);
+  for (int row = 0; row < height; ++row) {
+    const double* rowStart = weights.data() + std::size_t(row) * std::size_t(width);
+    for (int col = 0; col < width; ++col) rowWeights[row] += rowStart[col];
+    writeCdf(rowStart, width, table.data() + (height + 1) + std::size_t(row) * std::size_t(width + 1));
+  }
+  writeCdf(rowWeights.data(), height, table.data());
+  return table;
+}
+
+// ceil(log2(n)), 0 for n = 1: searchCdf halves its range rounding up.
+int binarySearchSteps(int n) {
+  int steps = 0;
+  while ((int64_t(1) << steps) < n) ++steps;
+  return steps;
+}
+
+}  // namespace
+
+EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler) {
+  requireKernelAddressable(envmap);
+  const RgbImage& image = envmap.image;
+  EnvmapTables tables;
+  tables.width = image.width;
+  tables.height = image.height;
+
+  std::vector<double> weights = luminanceWeights(image);
+  double total = 0;
+  for (double w : weights) total += w;
+  tables.uniformFallback = !(total > 0);
+  if (tables.uniformFallback) {
+    weights = sphereWeights(image.width, image.height);
+    total = 0;
+    for (double w : weights) total += w;
+  }
+
+  tables.texels.resize(weights.size() * 4);
+  for (std::size_t t = 0; t < weights.size(); ++t) {
+    for (int c = 0; c < 3; ++c) tables.texels[4 * t + c] = image.rgb[3 * t + c];
+    tables.texels[4 * t + 3] = float(weights[t] / total);
+  }
+
+  tables.useCdf = sampler == EnvmapSampler::Cdf;
+  if (tables.useCdf) {
+    tables.samplerTable = cdfTables(weights, image.width, image.height);
+    tables.aliasIndex = {0};
+    tables.cdfStepsRow = binarySearchSteps(image.height);
+    tables.cdfStepsCol = binarySearchSteps(image.width);
+  } else {
+    AliasTable alias = buildAliasTable(std::move(weights));
+    tables.samplerTable = std::move(alias.probability);
+    tables.aliasIndex = std::move(alias.alias);
+  }
+  return tables;
+}
+
+}  // namespace misalloc

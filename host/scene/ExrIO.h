@@ -1,0 +1,47 @@
+#pragma once
+// Reading and writing scanline OpenEXR images as 32-bit float channels.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace misalloc {
+
+// Linear RGB radiance, 3 floats per pixel, row-major, row 0 (the top) first.
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+};
+
+// One channel value of an image: column x, row y (0 = top), channel 'R', 'G' or 'B'.
+struct TexelLocation {
+  int x = 0, y = 0;
+  char channel = 'R';
+};
+
+// "x=12, y=3, channel G", for messages.
+std::string toString(const TexelLocation& location);
+
+// What readExr repaired: negative channel values (not radiance, but left by some
+// filters and HDR merges) are set to 0 so the caller can warn instead of failing.
+struct ReadWarnings {
+  std::size_t negativeValues = 0;
+  TexelLocation firstNegative;  // meaningful when negativeValues > 0
+};
+
+// Reads the R, G and B channels of `path` as float, whatever their stored type
+// (half, float or uint); an alpha or any other channel is ignored. Throws InputError,
+// naming the file, if it is missing, not an OpenEXR file, truncated or corrupt,
+// lacks R, G or B, has an empty data window, or holds NaN or infinite values.
+RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr);
+
+// Writes float R, G, B with ZIP compression. Both writers encode the whole file in
+// memory and replace `path` with writeFileAtomically, so a failure (InputError) never
+// leaves a partial file or damages an existing one.
+void writeExr(const std::string& path, const RgbImage& image);
+
+// Writes one float channel per plane (width × height values, row 0 first), named by
+// `names`, e.g. per-pixel allocation maps.
+void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
+                      const std::vector<std::vector<float>>& planes);
+
+}  // namespace misalloc

@@ -1,0 +1,73 @@
+// Techniques of the envmap × BRDF estimator and one sample of the balance-heuristic
+// MIS estimator (000 eq. 4.1–4.3). Host side: host/render/Technique.h and
+// host/render/HostSampler.cpp (the C++ reference of kernels/sample.cl).
+#ifndef MA_ESTIMATOR_H
+#define MA_ESTIMATOR_H
+#include "common.h"
+#include "envmap.h"
+#include "phong.h"
+#include "rng.h"
+
+#define MA_MAX_TECHNIQUES 3
+// Technique 0 samples the envmap. With the BRDF as one technique, 1 samples BRDF×cos
+// (the mixture of both lobes); split into lobes, 1 is the cosine lobe, 2 the Phong lobe.
+#define MA_TECHNIQUE_ENVMAP 0
+
+typedef struct {
+  int techniqueCount;  // M
+  int splitBrdf;       // M = 3: the BRDF's lobes are techniques of their own
+  MaVec3 mirror;       // mirror direction of ω_o about the normal (z)
+} TechniqueSet;
+
+MA_FN MaVec3 sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd) {
+  if (technique == MA_TECHNIQUE_ENVMAP) return sampleEnvmap(env, rnd);
+  if (!ts.splitBrdf) return sampleBrdf(b, ts.mirror, rnd);
+  float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
+  return technique == 1 ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
+}
+
+// p_k(ω_i) of every technique, given the envmap's pdf at ω_i.
+MA_FN void techniquePdfs(TechniqueSet ts, PhongParams b, MaVec3 wi, float envmapPdf, float* pdfs) {
+  pdfs[0] = envmapPdf;
+  pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, ts.mirror);
+  pdfs[2] = ts.splitBrdf ? specularPdf(b, wi, ts.mirror) : 0.0f;
+}
+
+// 000 eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
+MA_FN float mixturePdf(int techniqueCount, const float* alpha, const float* pdfs) {
+  float p = 0.0f;
+  MA_UNROLL
+  for (int k = 0; k < techniqueCount; ++k) p = ma_fma(alpha[k], pdfs[k], p);
+  return p;
+}
+
+typedef struct {
+  float r, g, b;  // f(ω_i) = L(ω_i) f_r(ω_o, ω_i) cos θ_i
+  float pdfs[MA_MAX_TECHNIQUES];
+} SampleValue;
+
+MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi) {
+  EnvmapHit hit = envmapLookup(env, wi);
+  float cosTheta = ma_max(wi.z, 0.0f);
+  float brdfCos = phongBrdf(b, wi, ts.mirror) * cosTheta;
+  SampleValue s;
+  s.r = hit.r * brdfCos;
+  s.g = hit.g * brdfCos;
+  s.b = hit.b * brdfCos;
+  techniquePdfs(ts, b, wi, hit.pdf, s.pdfs);
+  return s;
+}
+
+// The one-sample estimator picks technique k with probability α_k.
+MA_FN int chooseTechnique(int techniqueCount, const float* alpha, float u) {
+  int k = 0;
+  float cdf = alpha[0];
+  MA_UNROLL
+  for (int j = 1; j < techniqueCount; ++j) {
+    k = u >= cdf ? j : k;
+    cdf += alpha[j];
+  }
+  return k;
+}
+
+#endif

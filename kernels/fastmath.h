@@ -1,0 +1,91 @@
+// Inlinable float approximations of log2, exp2, pow, sin/cos, acos and atan2.
+// OpenCL builtins are opaque calls on PoCL that cost up to ~400 cycles and keep the
+// kernel scalar (../shared/notes/pocl-performance.md, rule 2); these vectorise.
+// tests/test_fastmath.cpp bounds their error against the C++ standard library.
+#ifndef MA_FASTMATH_H
+#define MA_FASTMATH_H
+#include "common.h"
+
+#define MA_LN2 0.69314718055994530942f
+#define MA_LOG2E 1.44269504088896340736f
+
+// log2(x) for finite x > 0: exponent plus an atanh series for the mantissa in
+// [√½, √2), |t| ≤ 0.1716, so five terms reach float precision.
+MA_FN float fastLog2(float x) {
+  ma_uint bits = ma_as_uint(x);
+  int e = (int)((bits >> 23) & 0xffu) - 127;
+  float m = ma_as_float((bits & 0x7fffffu) | 0x3f800000u);
+  int big = m > 1.41421356f;
+  m = big ? 0.5f * m : m;
+  e += big;
+  float t = (m - 1.0f) / (m + 1.0f);
+  float t2 = t * t;
+  float series = ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 1.0f / 9.0f, 1.0f / 7.0f), 1.0f / 5.0f), 1.0f / 3.0f), 1.0f);
+  return (float)e + 2.0f * MA_LOG2E * t * series;
+}
+
+// 2^y: integer part into the exponent, fraction by a degree-7 Taylor series of
+// e^g about the middle of [0, 1), |g| ≤ ln2/2. Underflows to 0 below 2^-126.
+MA_FN float fastExp2(float y) {
+  y = ma_min(ma_max(y, -127.0f), 127.0f);
+  float i = ma_floor(y);
+  float g = (y - i - 0.5f) * MA_LN2;
+  float p = ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, 1.0f / 5040.0f, 1.0f / 720.0f), 1.0f / 120.0f),
+                                                      1.0f / 24.0f), 1.0f / 6.0f), 0.5f), 1.0f), 1.0f);
+  p *= 1.41421356237309505f;
+  int ei = (int)i + 127;
+  float scale = ma_as_float((ma_uint)(ei > 0 ? ei : 0) << 23);
+  return ei > 0 ? p * scale : 0.0f;
+}
+
+// x^y for x ≥ 0, y > 0 (0^y = 0).
+MA_FN float fastPow(float x, float y) { return x > 0.0f ? fastExp2(y * fastLog2(x)) : 0.0f; }
+
+typedef struct {
+  float s, c;
+} MaSinCos;
+
+// sin and cos of 2πu for u in [0, 1]: the quadrant comes from u exactly, the
+// remainder |r| ≤ π/4 from two short Taylor polynomials (error ~2e-9).
+MA_FN MaSinCos sinCos2Pi(float u) {
+  float v = 4.0f * u;
+  float q = ma_floor(v + 0.5f);
+  float r = (v - q) * (0.5f * MA_PI);
+  float r2 = r * r;
+  float sr = r * ma_fma(r2, ma_fma(r2, ma_fma(r2, ma_fma(r2, 1.0f / 362880.0f, -1.0f / 5040.0f), 1.0f / 120.0f), -1.0f / 6.0f), 1.0f);
+  float cr = ma_fma(r2, ma_fma(r2, ma_fma(r2, ma_fma(r2, 1.0f / 40320.0f, -1.0f / 720.0f), 1.0f / 24.0f), -0.5f), 1.0f);
+  // Rotate by q quarter turns, with selects rather than branches that vectorise.
+  int quadrant = (int)q;
+  float sign = (quadrant & 2) ? -1.0f : 1.0f;
+  MaSinCos out;
+  out.s = sign * ((quadrant & 1) ? cr : sr);
+  out.c = sign * ((quadrant & 1) ? -sr : cr);
+  return out;
+}
+
+// acos(x) on [-1, 1]: Abramowitz & Stegun 4.4.46, |error| ≤ 2e-8 on [0, 1].
+MA_FN float fastAcos(float x) {
+  float a = ma_min(ma_abs(x), 1.0f);
+  float p = ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, -0.0012624911f, 0.0066700901f), -0.0170881256f),
+                                                     0.0308918810f), -0.0501743046f), 0.0889789874f), -0.2145988016f), 1.5707963050f);
+  float r = ma_sqrt(1.0f - a) * p;
+  return x < 0.0f ? MA_PI - r : r;
+}
+
+// atan2(y, x) mapped to [0, 2π): atan on [0, 1] by Abramowitz & Stegun 4.4.49
+// (|error| ≤ 2e-8), extended to all octants.
+MA_FN float fastAtan2Positive(float y, float x) {
+  float ax = ma_abs(x), ay = ma_abs(y);
+  float hi = ma_max(ma_max(ax, ay), 1e-30f);
+  float t = ma_min(ax, ay) / hi;
+  float t2 = t * t;
+  float p = ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 0.0028662257f, -0.0161657367f),
+                                                        0.0429096138f), -0.0752896400f), 0.1065626393f), -0.1420889944f),
+                                     0.1999355085f), -0.3333314528f), 1.0f);
+  float r = t * p;
+  r = ay > ax ? 0.5f * MA_PI - r : r;
+  r = x < 0.0f ? MA_PI - r : r;
+  return y < 0.0f ? 2.0f * MA_PI - r : r;
+}
+
+#endif

@@ -1,0 +1,85 @@
+// One pixel's share of a sampling stage: which technique takes sample j, the sample's
+// contribution to the estimate, and the running sums the allocations use. Shared by
+// kernels/sample.cl and its C++ reference (host/render/HostSampler.cpp). Everything is
+// scalar fields, not arrays: PoCL keeps a kernel scalar that indexes private arrays
+// dynamically.
+#ifndef MA_PIXEL_H
+#define MA_PIXEL_H
+#include "estimator.h"
+
+typedef struct {
+  int techniqueCount, stageSamples, oneSample;
+  int n0, n1, n2;                   // this stage's counts (one-sample: expected counts)
+  ma_uint first0, first1, first2;   // index of each technique's first sample this stage
+} StageCounts;
+
+typedef struct {
+  int technique;
+  float r, g, b;  // f / (N p_α), with p_α = Σ_k α_k p_k, α_k = n_k/N (000 eq. 4.2–4.3)
+  float w;        // Y(f) / p_α: the luminance sample value of the balance heuristic
+} SampleContribution;
+
+typedef struct {
+  ma_acc r, g, b;        // Σ f / (N p_α): this stage's unbiased estimate
+  ma_acc w0, w1, w2;     // per technique: Σ w
+  ma_acc ww0, ww1, ww2;  // per technique: Σ w²
+} PixelSums;
+
+// Sample j of the stage. Multi-sample: the first n0 samples are technique 0's, the next
+// n1 technique 1's, ... One-sample: the technique is drawn with probabilities α_k.
+MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c, int j,
+                                         ma_uint seedLo, ma_uint seedHi, ma_uint pixel) {
+  float N = (float)c.stageSamples;
+  float alpha[MA_MAX_TECHNIQUES];
+  alpha[0] = (float)c.n0 / N;
+  alpha[1] = (float)c.n1 / N;
+  alpha[2] = (float)c.n2 / N;
+  int technique;
+  ma_uint index;
+  if (c.oneSample) {
+    MaRandom4 choice = philoxDraw(seedLo, seedHi, pixel, MA_STREAM_TECHNIQUE_CHOICE, c.first0 + (ma_uint)j);
+    technique = chooseTechnique(c.techniqueCount, alpha, uniformFloat(choice.v[0]));
+    index = c.first0 + (ma_uint)j;
+  } else {
+    technique = j < c.n0 ? 0 : (j < c.n0 + c.n1 ? 1 : 2);
+    int start = technique == 0 ? 0 : (technique == 1 ? c.n0 : c.n0 + c.n1);
+    ma_uint first = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
+    index = first + (ma_uint)(j - start);
+  }
+  MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
+  MaVec3 wi = sampleTechnique(ts, env, b, technique, rnd);
+  SampleValue s = evaluateSample(ts, env, b, wi);
+  float p = mixturePdf(c.techniqueCount, alpha, s.pdfs);
+  // p = 0 only where no technique can sample, so f = 0 there too.
+  float invP = p > 0.0f ? 1.0f / p : 0.0f;
+  SampleContribution out;
+  out.technique = technique;
+  out.r = s.r * invP / N;
+  out.g = s.g * invP / N;
+  out.b = s.b * invP / N;
+  out.w = luminance(s.r, s.g, s.b) * invP;
+  return out;
+}
+
+MA_FN PixelSums zeroPixelSums(void) {
+  PixelSums z;
+  z.r = z.g = z.b = 0;
+  z.w0 = z.w1 = z.w2 = 0;
+  z.ww0 = z.ww1 = z.ww2 = 0;
+  return z;
+}
+
+MA_FN void addContribution(PixelSums* sums, SampleContribution s) {
+  sums->r += (ma_acc)s.r;
+  sums->g += (ma_acc)s.g;
+  sums->b += (ma_acc)s.b;
+  ma_acc w = (ma_acc)s.w, ww = w * w;
+  sums->w0 += s.technique == 0 ? w : 0;
+  sums->w1 += s.technique == 1 ? w : 0;
+  sums->w2 += s.technique == 2 ? w : 0;
+  sums->ww0 += s.technique == 0 ? ww : 0;
+  sums->ww1 += s.technique == 1 ? ww : 0;
+  sums->ww2 += s.technique == 2 ? ww : 0;
+}
+
+#endif

@@ -1,0 +1,34 @@
+// Counter-based random numbers: Philox4x32-10 (Random123) keyed by the seed and
+// counted by (pixel, stream, sample index), so a sample's numbers do not depend on
+// the work-group size, the device, or which other samples were taken.
+#ifndef MA_RNG_H
+#define MA_RNG_H
+#include "common.h"
+#ifdef __OPENCL_VERSION__
+#include <Random123/philox.h>
+#endif
+
+// Stream ids: one per technique (0..2), and one for the one-sample estimator's
+// choice of technique.
+#define MA_STREAM_TECHNIQUE_CHOICE 7u
+
+typedef struct {
+  ma_uint v[4];
+} MaRandom4;
+
+MA_FN MaRandom4 philoxDraw(ma_uint seedLo, ma_uint seedHi, ma_uint pixel, ma_uint stream, ma_uint index) {
+  philox4x32_ctr_t ctr = {{pixel, stream, index, 0u}};
+  philox4x32_key_t key = {{seedLo, seedHi}};
+  philox4x32_ctr_t r = philox4x32_R(10, ctr, key);
+  MaRandom4 out;
+  out.v[0] = r.v[0];
+  out.v[1] = r.v[1];
+  out.v[2] = r.v[2];
+  out.v[3] = r.v[3];
+  return out;
+}
+
+// The top 24 bits as a float in [0, 1): exact, never 1.
+MA_FN float uniformFloat(ma_uint bits) { return (float)(bits >> 8) * (1.0f / 16777216.0f); }
+
+#endif

@@ -1,0 +1,101 @@
+// One stage of the multi-sample (000 eq. 4.1) or one-sample balance-heuristic
+// estimator for every pixel at once. Host side: host/render/Sampler.h runs it,
+// host/render/HostSampler.cpp is its C++ reference.
+//
+// Compile-time options (sampleKernelOptions in host/render/Sampler.cpp):
+// MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
+// MA_COSK (< 0: the texels), MA_ONE_SAMPLE. Constants fold the unused techniques,
+// sampler and estimator away.
+#include "pixel.h"
+
+// The per-pixel sums live in local memory, one row per sum: PoCL then keeps nothing
+// but the loop counter across the barrier, and nothing that its earlier passes could
+// pack into short vectors, which would stop it vectorising across work-items.
+enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
+
+// Everything one sample needs, re-read from global memory (cached) at each sample for
+// the same reason.
+MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* samplerTable,
+                                       __global const uint* aliasIndex, int width, int height,
+                                       __global const float* brdfParams, MaVec3 mirror, __global const int* counts,
+                                       __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
+                                       int pixel, int j) {
+  EnvmapView env;
+  env.texels = texels;
+  env.samplerTable = samplerTable;
+  env.aliasIndex = aliasIndex;
+  env.width = width;
+  env.height = height;
+  env.useCdf = MA_USE_CDF;
+  env.cdfStepsRow = MA_CDF_STEPS_ROW;
+  env.cdfStepsCol = MA_CDF_STEPS_COL;
+  env.coskExponent = MA_COSK;
+
+  TechniqueSet ts;
+  ts.techniqueCount = MA_TECHNIQUES;
+  ts.splitBrdf = MA_SPLIT_BRDF;
+  ts.mirror = mirror;
+
+  PhongParams b;
+  b.rhoD = brdfParams[4 * pixel + 0];
+  b.rhoS = brdfParams[4 * pixel + 1];
+  b.n = brdfParams[4 * pixel + 2];
+
+  __global const int* n = counts + pixel * MA_TECHNIQUES;
+  __global const uint* first = firstIndex + pixel * MA_TECHNIQUES;
+  StageCounts c;
+  c.techniqueCount = MA_TECHNIQUES;
+  c.stageSamples = stageSamples;
+  c.oneSample = MA_ONE_SAMPLE;
+  c.n0 = n[0];
+  c.n1 = n[1];
+  c.n2 = MA_TECHNIQUES > 2 ? n[MA_TECHNIQUES - 1] : 0;
+  c.first0 = first[0];
+  c.first1 = first[1];
+  c.first2 = MA_TECHNIQUES > 2 ? first[MA_TECHNIQUES - 1] : 0u;
+  return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
+}
+
+__kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
+    __global const float* texels, __global const float* samplerTable, __global const uint* aliasIndex, int width,
+    int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
+    __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
+    int pixelCount, __global ma_acc* estimate, __global ma_acc* moments) {
+  __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
+  int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
+  // Padding work-items run the loop too: the barrier needs every work-item.
+  int pixel = gid < pixelCount ? gid : pixelCount - 1;
+  for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
+  for (int j = 0; j < stageSamples; ++j) {
+    SampleContribution c = sampleOfPixel(texels, samplerTable, aliasIndex, width, height, brdfParams,
+                                         makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
+                                         seedLo, seedHi, pixel, j);
+    ma_acc w = (ma_acc)c.w, ww = w * w;
+    sums[SUM_R][lid] += (ma_acc)c.r;
+    sums[SUM_G][lid] += (ma_acc)c.g;
+    sums[SUM_B][lid] += (ma_acc)c.b;
+    sums[SUM_W0][lid] += c.technique == 0 ? w : 0;
+    sums[SUM_WW0][lid] += c.technique == 0 ? ww : 0;
+    sums[SUM_W1][lid] += c.technique == 1 ? w : 0;
+    sums[SUM_WW1][lid] += c.technique == 1 ? ww : 0;
+    if (MA_TECHNIQUES > 2) {
+      sums[SUM_W2][lid] += c.technique == 2 ? w : 0;
+      sums[SUM_WW2][lid] += c.technique == 2 ? ww : 0;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
+  }
+  if (gid < pixelCount) {
+    estimate[3 * pixel + 0] = sums[SUM_R][lid];
+    estimate[3 * pixel + 1] = sums[SUM_G][lid];
+    estimate[3 * pixel + 2] = sums[SUM_B][lid];
+    __global ma_acc* m = moments + pixel * MA_TECHNIQUES * 2;
+    m[0] = sums[SUM_W0][lid];
+    m[1] = sums[SUM_WW0][lid];
+    m[2] = sums[SUM_W1][lid];
+    m[3] = sums[SUM_WW1][lid];
+    if (MA_TECHNIQUES > 2) {
+      m[4] = sums[SUM_W2][lid];
+      m[5] = sums[SUM_WW2][lid];
+    }
+  }
+}

@@ -1,0 +1,46 @@
+#pragma once
+// Small scenes and per-pixel statistics shared by the sampler tests.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "render/Method.h"
+#include "render/Sampler.h"
+#include "render/Scene.h"
+
+namespace misalloc::test {
+
+inline Scene smallScene(const std::string& envmap, const std::string& grid, int w, int h, bool split = false,
+                        EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0) {
+  SceneOptions o;
+  o.envmap = envmap;
+  o.grid = grid;
+  o.width = w;
+  o.height = h;
+  o.splitBrdf = split;
+  o.sampler = sampler;
+  o.viewTheta = viewTheta;
+  o.proceduralWidth = 128;
+  return makeScene(o);
+}
+
+// Mean and standard error of the pixels' luminance estimates, for scenes whose
+// pixels all have the same expected value (a uniform grid): independent estimates.
+struct MeanAndError {
+  double mean, standardError;
+};
+
+inline MeanAndError pixelMean(const std::vector<double>& rgb) {
+  const size_t n = rgb.size() / 3;
+  double sum = 0, sumSquares = 0;
+  for (size_t p = 0; p < n; ++p) {
+    double y = 0.2126 * rgb[3 * p] + 0.7152 * rgb[3 * p + 1] + 0.0722 * rgb[3 * p + 2];
+    sum += y;
+    sumSquares += y * y;
+  }
+  double mean = sum / n;
+  double variance = (sumSquares - n * mean * mean) / (n - 1);
+  return {mean, std::sqrt(std::max(variance, 0.0) / n)};
+}
+
+}  // namespace misalloc::test

@@ -1,0 +1,131 @@
+// The command line: bad input gets a clear message naming the problem, a non-zero
+// exit, and no output file; a good run writes its image and report.
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "Error.h"
+#include "TestDevice.h"
+#include "cl/Device.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CommandResult {
+  int exitCode;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult runMisalloc(const std::string& args, const std::string& environment = "") {
+  std::string command = fmt::format("{} {} {} 2>&1", environment, MISALLOC_BINARY, args);
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() : path(fs::temp_directory_path() / fmt::format("misalloc_cli_{}", ::getpid())) {
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+}  // namespace
+
+TEST_CASE("render writes an image and a report", "[cli]") {
+  TempDir dir;
+  auto out = dir.path / "r.exr", report = dir.path / "r.json";
+  auto r = runMisalloc(fmt::format("render --envmap cosk:1 --grid seed000 --size 16x8 --spp 8 --device cpu "
+                                   "--out {} --report {} --cache-dir {}",
+                                   out.string(), report.string(), (dir.path / "cache").string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  REQUIRE(fs::exists(out));
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  CHECK(j["method"] == "equal");
+  CHECK(j["spp"] == 8);
+  CHECK(j["reference"]["source"] == "analytic (000 eq. 6.17)");
+  CHECK(j["rmse_x1000"].get<double>() > 0);
+  CHECK(j["time_s"]["kernel"].get<double>() > 0);
+  CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());
+}
+
+TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
+  TempDir dir;
+  auto out = dir.path / "r.exr", report = dir.path / "r.json";
+  const std::string outputs = fmt::format("--out {} --report {} --reference none", out.string(), report.string());
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"--envmap /no/such/file.exr", "/no/such/file.exr"},
+      {"--envmap no_such_map", "no_such_map"},
+      {"--spp 0", "--spp 0"},
+      {"--size 0x0", "--size 0x0"},
+      {"--size 12", "--size 12"},
+      {"--method magic", "unknown --method 'magic'"},
+      {"--method exact", "not implemented yet"},
+      {"--grid marble", "unknown --grid 'marble'"},
+      {"--grid uniform:0.8,0.8,10", "ρd + ρs ≤ 1"},
+      {"--device 99", "--device '99'"},
+      {"--device quantum", "--device 'quantum'"},
+      {"--estimator both", "--estimator 'both'"},
+      {"--envmap-sampler tree", "--envmap-sampler 'tree'"},
+      {"--view 95", "--view 95"},
+      {"--envmap cosk:x", "cosk:x"},
+  };
+  for (const Case& c : cases) {
+    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 4 {} {}", outputs, c.args));
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.exitCode != 0);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+    CHECK_FALSE(fs::exists(report));
+  }
+}
+
+TEST_CASE("an existing output survives a failed run", "[cli][bad-input]") {
+  TempDir dir;
+  auto out = dir.path / "r.exr";
+  std::ofstream(out) << "previous";
+  auto r = runMisalloc(fmt::format("render --spp 0 --out {} --report {}", out.string(), (dir.path / "r.json").string()));
+  CHECK(r.exitCode != 0);
+  std::ifstream in(out);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(content == "previous");
+}
+
+TEST_CASE("no OpenCL platform: the message says how to install PoCL", "[cli][bad-input]") {
+  // An empty vendor folder hides every ICD from the loader.
+  TempDir dir;
+  auto r = runMisalloc("devices", fmt::format("OCL_ICD_VENDORS={} OPENCL_VENDOR_PATH={}", dir.path.string(),
+                                              dir.path.string()));
+  INFO(r.output);
+  CHECK(r.exitCode != 0);
+  CHECK(r.output.find("pocl-opencl-icd") != std::string::npos);
+}
+
+TEST_CASE("a kernel build failure shows the build log", "[cli][bad-input]") {
+  using namespace misalloc;
+  // A missing -D makes sample.cl fail to compile.
+  try {
+    buildProgram(test::testDevice(), "sample.cl", "-cl-std=CL1.2");
+    FAIL("the build should have failed");
+  } catch (const DeviceError& e) {
+    std::string what = e.what();
+    CHECK(what.find("Build log") != std::string::npos);
+    CHECK(what.find("MA_TECHNIQUES") != std::string::npos);
+  }
+}

@@ -1,0 +1,579 @@
+// makeEnvmap, the alias table and the envmap's sampling tables, checked through the
+// kernels' own functions (KernelCode.h): the pdf the kernels evaluate is normalised,
+// the texels they draw follow it, and a texel of zero weight is never drawn.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "Error.h"
+#include "KernelCode.h"
+#include "scene/AliasTable.h"
+#include "scene/Envmap.h"
+#include "scene/EnvmapDistribution.h"
+
+namespace kern = misalloc::kern;
+using Catch::Matchers::Contains;
+using misalloc::Envmap;
+using misalloc::EnvmapSampler;
+using misalloc::EnvmapTables;
+using misalloc::RgbImage;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kFloatRounding = 0x1p-24;  // relative error of one rounding to float
+constexpr double kDoubleRounding = 0x1p-53;
+constexpr double kGrid24 = 0x1p24;  // uniformFloat's values are k / 2^24
+constexpr double kPValueThreshold = 1e-3;
+
+kern::EnvmapView viewOf(const EnvmapTables& tables) {
+  kern::EnvmapView view;
+  view.texels = tables.texels.data();
+  view.samplerTable = tables.samplerTable.data();
+  view.aliasIndex = tables.aliasIndex.data();
+  view.width = tables.width;
+  view.height = tables.height;
+  view.useCdf = tables.useCdf;
+  view.cdfStepsRow = tables.cdfStepsRow;
+  view.cdfStepsCol = tables.cdfStepsCol;
+  view.coskExponent = -1;
+  return view;
+}
+
+// The texel that kernels/envmap.h's sampleEnvmap picks for these random numbers.
+int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) {
+  return view.useCdf ? kern::sampleCdfTable(view, kern::uniformFloat(r.v[0]), kern::uniformFloat(r.v[1]))
+                     : kern::sampleAliasTable(view, r.v[0], kern::uniformFloat(r.v[1]));
+}
+
+std::vector<double> texelProbabilities(const EnvmapTables& tables) {
+  std::vector<double> p(tables.texels.size() / 4);
+  for (std::size_t t = 0; t < p.size(); ++t) p[t] = tables.texels[4 * t + 3];
+  return p;
+}
+
+// Grey texels of the given luminance.
+Envmap greyMap(int width, int height, const std::function<float(int col, int row)>& luminance) {
+  Envmap map;
+  map.image = {width, height, std::vector<float>(std::size_t(width) * height * 3)};
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col)
+      for (int c = 0; c < 3; ++c) map.image.rgb[3 * (std::size_t(row) * width + col) + c] = luminance(col, row);
+  map.description = "synthetic";
+  return map;
+}
+
+struct NamedMap {
+  std::string name;
+  Envmap map;
+};
+
+// Small synthetic maps for the edge cases, two procedural ones and the real map of
+// the highest contrast.
+const std::vector<NamedMap>& testMaps() {
+  static const std::vector<NamedMap> maps = [] {
+    std::vector<NamedMap> m;
+    m.push_back({"1x1", greyMap(1, 1, [](int, int) { return 2.0f; })});
+    m.push_back({"2x1", greyMap(2, 1, [](int col, int) { return col == 0 ? 1.0f : 3.0f; })});
+    m.push_back({"single bright texel", greyMap(8, 4, [](int col, int row) { return col == 5 && row == 1 ? 10.0f : 0.0f; })});
+    m.push_back({"black upper hemisphere", greyMap(8, 4, [](int col, int row) { return row < 2 ? 0.0f : 1.0f + col; })});
+    m.push_back({"all black", greyMap(8, 4, [](int, int) { return 0.0f; })});
+    // Zero weight at both ends of the rows and columns and in between.
+    m.push_back({"zero rows and columns", greyMap(7, 5, [](int col, int row) {
+                   return row == 0 || row == 2 || row == 4 || col == 0 || col == 3 || col == 6 ? 0.0f : float(col + row);
+                 })});
+    m.push_back({"sun", misalloc::makeEnvmap("sun", 64)});
+    m.push_back({"cosk:3", misalloc::makeEnvmap("cosk:3", 64)});
+    m.push_back({"rooitou_park", misalloc::makeEnvmap(MISALLOC_SOURCE_DIR "/data/envmaps/rooitou_park.exr")});
+    return m;
+  }();
+  return maps;
+}
+
+// Q(a, x) = Γ(a, x) / Γ(a), the regularised upper incomplete gamma function: the
+// series for P below a + 1, Lentz's continued fraction for Q above (Numerical
+// Recipes §6.2). The loops stop when terms no longer change a double.
+double upperRegularisedGamma(double a, double x) {
+  if (x <= 0) return 1;
+  const double logPrefix = a * std::log(x) - x - std::lgamma(a);
+  const double tiny = std::numeric_limits<double>::min();
+  if (x < a + 1) {
+    double term = 1 / a, sum = term;
+    for (int n = 1; term > sum * kDoubleRounding; ++n) {
+      term *= x / (a + n);
+      sum += term;
+    }
+    return 1 - sum * std::exp(logPrefix);
+  }
+  double b = x + 1 - a, c = 1 / tiny, d = 1 / b, h = d;
+  for (int i = 1;; ++i) {
+    double an = -i * (i - a);
+    b += 2;
+    d = an * d + b;
+    d = std::abs(d) < tiny ? tiny : d;
+    c = b + an / c;
+    c = std::abs(c) < tiny ? tiny : c;
+    d = 1 / d;
+    h *= d * c;
+    if (std::abs(d * c - 1) <= kDoubleRounding) break;
+  }
+  return std::exp(logPrefix) * h;
+}
+
+struct ChiSquare {
+  double statistic = 0;
+  int degreesOfFreedom = 0;
+  double pValue() const { return upperRegularisedGamma(0.5 * degreesOfFreedom, 0.5 * statistic); }
+};
+
+// Pearson's test of observed counts against probabilities. Bins expecting fewer than
+// 5 counts, where the χ² approximation fails, are pooled; a pool still below 5 joins
+// the smallest regular bin.
+ChiSquare chiSquare(const std::vector<uint64_t>& observed, const std::vector<double>& probability, uint64_t n) {
+  std::vector<std::pair<double, double>> bins;  // expected, observed
+  double pooledExpected = 0, pooledObserved = 0;
+  for (std::size_t i = 0; i < observed.size(); ++i) {
+    double expected = probability[i] * double(n);
+    if (expected >= 5) {
+      bins.emplace_back(expected, double(observed[i]));
+    } else {
+      pooledExpected += expected;
+      pooledObserved += double(observed[i]);
+    }
+  }
+  if (pooledExpected >= 5 || bins.empty()) {
+    bins.emplace_back(pooledExpected, pooledObserved);
+  } else {
+    auto smallest = std::min_element(bins.begin(), bins.end());
+    smallest->first += pooledExpected;
+    smallest->second += pooledObserved;
+  }
+  ChiSquare result;
+  for (const auto& [expected, count] : bins) result.statistic += (count - expected) * (count - expected) / expected;
+  result.degreesOfFreedom = int(bins.size()) - 1;
+  return result;
+}
+
+// How many of the 2^24 values k / 2^24 of uniformFloat lie below x ∈ [0, 1].
+double gridCountBelow(float x) { return std::ceil(double(x) * kGrid24); }
+
+// The probability that mul_hi(bits, n) picks bucket i for uniform 32-bit `bits`: the
+// bits from ceil(i 2^32 / n) up to ceil((i + 1) 2^32 / n).
+double aliasBucketProbability(uint64_t i, uint64_t n) {
+  auto firstBits = [n](uint64_t bucket) { return ((bucket << 32) + n - 1) / n; };
+  return double(firstBits(i + 1) - firstBits(i)) / 0x1p32;
+}
+
+// The exact probability of each texel under the kernels' samplers, from the stored
+// tables and the discrete uniforms they draw: alias buckets from mul_hi of 32 bits,
+// coins and CDF lookups from 24-bit uniformFloat, with searchCdf picking the last i
+// with cdf[i] ≤ u (checked on its own below).
+std::vector<double> kernelTexelDistribution(const EnvmapTables& tables) {
+  const std::size_t n = std::size_t(tables.width) * tables.height;
+  std::vector<double> p(n, 0.0);
+  if (tables.useCdf) {
+    const float* marginal = tables.samplerTable.data();
+    for (int row = 0; row < tables.height; ++row) {
+      double rowP = (gridCountBelow(marginal[row + 1]) - gridCountBelow(marginal[row])) / kGrid24;
+      const float* conditional = marginal + (tables.height + 1) + std::size_t(row) * (tables.width + 1);
+      for (int col = 0; col < tables.width; ++col)
+        p[std::size_t(row) * tables.width + col] =
+            rowP * (gridCountBelow(conditional[col + 1]) - gridCountBelow(conditional[col])) / kGrid24;
+    }
+    return p;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    double bucketP = aliasBucketProbability(i, n);
+    double accept = std::min(gridCountBelow(tables.samplerTable[i]), kGrid24) / kGrid24;
+    p[i] += bucketP * accept;
+    p[tables.aliasIndex[i]] += bucketP * (1 - accept);
+  }
+  return p;
+}
+
+double totalVariation(const std::vector<double>& p, const std::vector<double>& q) {
+  double sum = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) sum += std::abs(p[i] - q[i]);
+  return sum;
+}
+
+}  // namespace
+
+TEST_CASE("the χ² p-value helper matches tabulated quantiles", "[envmap]") {
+  CHECK(upperRegularisedGamma(0.5, 0.5 * 3.841459) == Approx(0.05).epsilon(1e-5));
+  CHECK(upperRegularisedGamma(5.0, 0.5 * 18.307038) == Approx(0.05).epsilon(1e-5));
+  CHECK(upperRegularisedGamma(50.0, 0.5 * 135.806723) == Approx(0.01).epsilon(1e-5));
+  CHECK(upperRegularisedGamma(5000.0, 0.5 * 10000.0) == Approx(0.5).epsilon(1e-2));
+}
+
+TEST_CASE("kern::searchCdf returns the last index i with cdf[i] <= u", "[envmap]") {
+  // Every CDF of n ≤ 9 steps over the values {0, 0.25, 0.5, 1} (ties and jumps at
+  // both ends), probed at each value it holds and between them.
+  const float levels[] = {0.0f, 0.25f, 0.5f, 1.0f};
+  const float probes[] = {0.0f, 0.1f, 0.25f, 0.3f, 0.5f, 0.7f, 0.99999994f};
+  for (int n = 1; n <= 9; ++n) {
+    int steps = 0;
+    while ((1 << steps) < n) ++steps;
+    std::vector<int> level(n + 1, 0);  // nondecreasing level indices, cdf[n] = 1
+    level[n] = 3;
+    std::function<void(int)> enumerate = [&](int i) {
+      if (i == n) {
+        std::vector<float> cdf(n + 1);
+        for (int k = 0; k <= n; ++k) cdf[k] = levels[level[k]];
+        for (float u : probes) {
+          int expected = 0;
+          for (int k = 0; k < n; ++k)
+            if (cdf[k] <= u) expected = k;
+          INFO("n = " << n << ", u = " << u);
+          CHECK(kern::searchCdf(cdf.data(), n, steps, u) == expected);
+        }
+        return;
+      }
+      for (int l = level[i - 1]; l <= 3; ++l) {
+        level[i] = l;
+        enumerate(i + 1);
+      }
+    };
+    level[0] = 0;
+    enumerate(1);
+  }
+}
+
+TEST_CASE("buildEnvmapTables lays out the tables that kernels/envmap.h reads", "[envmap]") {
+  Envmap map = greyMap(5, 3, [](int col, int row) { return float(1 + col + 10 * row); });
+  map.image.rgb[0] = 7.0f;  // R of texel 0 differs from G and B
+  for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+    EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler);
+    CHECK(tables.width == 5);
+    CHECK(tables.height == 3);
+    CHECK_FALSE(tables.uniformFallback);
+    REQUIRE(tables.texels.size() == 4 * 15);
+    for (std::size_t t = 0; t < 15; ++t)
+      for (int c = 0; c < 3; ++c) CHECK(tables.texels[4 * t + c] == map.image.rgb[3 * t + c]);
+    // Texel (col, row) has weight luminance × sin θ at its centre.
+    double luminance0 = 0.2126 * 7 + 0.7152 + 0.0722;
+    double weight0 = luminance0 * std::sin(kPi / 6), weight14 = 25 * std::sin(5 * kPi / 6);
+    CHECK(tables.texels[4 * 14 + 3] / tables.texels[3] == Approx(weight14 / weight0).epsilon(4 * kFloatRounding));
+    if (sampler == EnvmapSampler::Alias) {
+      CHECK_FALSE(tables.useCdf);
+      CHECK(tables.samplerTable.size() == 15);
+      CHECK(tables.aliasIndex.size() == 15);
+    } else {
+      CHECK(tables.useCdf);
+      REQUIRE(tables.samplerTable.size() == 4 + 3 * 6);
+      CHECK(tables.aliasIndex == std::vector<uint32_t>{0});
+      CHECK(tables.cdfStepsRow == 2);
+      CHECK(tables.cdfStepsCol == 3);
+      for (int row = 0; row <= 3; ++row) {
+        const float* cdf = row == 0 ? &tables.samplerTable[0] : &tables.samplerTable[4 + (row - 1) * 6];
+        int n = row == 0 ? 3 : 5;
+        CHECK(cdf[0] == 0.0f);
+        CHECK(cdf[n] == 1.0f);
+        for (int i = 0; i < n; ++i) CHECK(cdf[i] < cdf[i + 1]);
+      }
+    }
+  }
+  EnvmapTables one = misalloc::buildEnvmapTables(greyMap(1, 1, [](int, int) { return 1.0f; }), EnvmapSampler::Cdf);
+  CHECK(one.cdfStepsRow == 0);
+  CHECK(one.cdfStepsCol == 0);
+  EnvmapTables real = misalloc::buildEnvmapTables(testMaps().back().map, EnvmapSampler::Cdf);
+  CHECK(real.cdfStepsRow == 9);
+  CHECK(real.cdfStepsCol == 10);
+}
+
+TEST_CASE("buildEnvmapTables falls back to uniform sampling only for a black map", "[envmap]") {
+  for (const auto& [name, map] : testMaps()) {
+    INFO(name);
+    EnvmapTables tables = misalloc::buildEnvmapTables(map, EnvmapSampler::Alias);
+    CHECK(tables.uniformFallback == (name == "all black"));
+  }
+  EnvmapTables black = misalloc::buildEnvmapTables(greyMap(8, 4, [](int, int) { return 0.0f; }), EnvmapSampler::Cdf);
+  for (int row = 0; row < 4; ++row) {
+    double expected = std::sin(kPi * (row + 0.5) / 4) / (8 * (2 * std::sin(kPi / 8) + 2 * std::sin(3 * kPi / 8)));
+    CHECK(black.texels[4 * (8 * row + 3) + 3] == Approx(expected).epsilon(4 * kFloatRounding));
+    CHECK(black.texels[4 * (8 * row + 3)] == 0.0f);  // the radiance stays black
+  }
+}
+
+TEST_CASE("buildEnvmapTables rejects maps the kernels cannot index", "[envmap]") {
+  Envmap huge;
+  huge.image.width = 32768;
+  huge.image.height = 16384;
+  huge.image.rgb.resize(3);  // the size check comes first; no need to allocate
+  huge.description = "huge.exr";
+  CHECK_THROWS_AS(misalloc::buildEnvmapTables(huge, EnvmapSampler::Alias), std::invalid_argument);
+  Envmap negative = greyMap(2, 1, [](int col, int) { return col == 0 ? 1.0f : -1.0f; });
+  CHECK_THROWS_AS(misalloc::buildEnvmapTables(negative, EnvmapSampler::Cdf), std::invalid_argument);
+}
+
+TEST_CASE("texel probabilities sum to 1 and both samplers share them", "[envmap]") {
+  for (const auto& [name, map] : testMaps()) {
+    INFO(name);
+    EnvmapTables alias = misalloc::buildEnvmapTables(map, EnvmapSampler::Alias);
+    EnvmapTables cdf = misalloc::buildEnvmapTables(map, EnvmapSampler::Cdf);
+    CHECK(alias.texels == cdf.texels);
+    std::vector<double> p = texelProbabilities(alias);
+    double sum = 0;
+    for (double x : p) sum += x;
+    // Each probability is rounded to float once; the double sums add ~N ulps.
+    CHECK(std::abs(sum - 1) <= kFloatRounding + double(p.size()) * kDoubleRounding);
+  }
+}
+
+TEST_CASE("the envmap pdf the kernels evaluate integrates to 1 over the sphere", "[envmap]") {
+  for (const auto& [name, map] : testMaps()) {
+    INFO(name);
+    EnvmapTables tables = misalloc::buildEnvmapTables(map, EnvmapSampler::Alias);
+    kern::EnvmapView view = viewOf(tables);
+    // The midpoint rule in (u, v), dω = 2π² sin θ du dv, with k × k points inside each
+    // texel: p sin θ is constant on a texel, so the rule is exact up to the rounding
+    // of a few float operations per point (P, the factor W H / 2π², sin θ, one division).
+    const int k = tables.width * tables.height > 100000 ? 2 : 4;
+    const int nu = k * tables.width, nv = k * tables.height;
+    double integral = 0;
+    for (int j = 0; j < nv; ++j) {
+      double v = (j + 0.5) / nv;
+      double rowWeight = 2 * kPi * kPi * std::sin(kPi * v) / (double(nu) * nv);
+      for (int i = 0; i < nu; ++i) {
+        double u = (i + 0.5) / nu;
+        integral += kern::envmapLookup(view, kern::latLongDirection(float(u), float(v))).pdf * rowWeight;
+      }
+    }
+    CHECK(std::abs(integral - 1) <= 16 * kFloatRounding);
+  }
+}
+
+TEST_CASE("envmapLookup at a texel's centre returns that texel's radiance and pdf", "[envmap]") {
+  for (const auto& [name, map] : testMaps()) {
+    INFO(name);
+    EnvmapTables tables = misalloc::buildEnvmapTables(map, EnvmapSampler::Cdf);
+    kern::EnvmapView view = viewOf(tables);
+    int mismatches = 0;
+    for (int row = 0; row < tables.height; ++row) {
+      for (int col = 0; col < tables.width; ++col) {
+        float u = (col + 0.5f) / tables.width, v = (row + 0.5f) / tables.height;
+        kern::EnvmapHit hit = kern::envmapLookup(view, kern::latLongDirection(u, v));
+        const float* texel = &tables.texels[4 * (std::size_t(row) * tables.width + col)];
+        double pdf = texel[3] * double(tables.width) * tables.height / (2 * kPi * kPi * std::sin(kPi * v));
+        bool same = hit.r == texel[0] && hit.g == texel[1] && hit.b == texel[2] &&
+                    std::abs(hit.pdf - pdf) <= 16 * kFloatRounding * pdf;
+        mismatches += same ? 0 : 1;
+      }
+    }
+    CHECK(mismatches == 0);
+  }
+}
+
+TEST_CASE("the kernels' samplers draw texels with the stored probabilities, never one of weight 0", "[envmap]") {
+  for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+    const bool cdf = sampler == EnvmapSampler::Cdf;
+    for (const auto& [name, map] : testMaps()) {
+      INFO(name << (cdf ? ", CDF" : ", alias"));
+      EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler);
+      std::vector<double> p = texelProbabilities(tables);
+
+      // Exactly, over every value of the random numbers. Each stored CDF value and
+      // acceptance probability is off by at most one float rounding and one step of
+      // the 2^-24 grid; a CDF texel depends on two such values, its row's and its
+      // own; and mul_hi's buckets are uniform only when N divides 2^32.
+      std::vector<double> exact = kernelTexelDistribution(tables);
+      double bucketBias = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) bucketBias += std::abs(aliasBucketProbability(i, p.size()) - 1.0 / p.size());
+      double bound = cdf ? 3 * kFloatRounding * (tables.width + tables.height) : 3 * kFloatRounding + bucketBias;
+      CHECK(totalVariation(exact, p) <= bound);
+      for (std::size_t t = 0; t < p.size(); ++t)
+        if (p[t] == 0) CHECK(exact[t] == 0);
+
+      // Statistically, through the kernels' functions and random numbers.
+      kern::EnvmapView view = viewOf(tables);
+      const uint64_t samples = 1000000;
+      std::vector<uint64_t> counts(p.size(), 0);
+      for (uint64_t i = 0; i < samples; ++i)
+        ++counts[sampledTexel(view, kern::philoxDraw(0x5eed, cdf ? 1 : 0, 0, 0, uint32_t(i)))];
+      uint64_t zeroWeightDraws = 0;
+      for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
+      CHECK(zeroWeightDraws == 0);
+      ChiSquare test = chiSquare(counts, p, samples);
+      INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
+      if (test.degreesOfFreedom > 0) CHECK(test.pValue() > kPValueThreshold);
+    }
+  }
+}
+
+TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {
+  // Up to the float rounding of (col + u) / W and of the direction's components.
+  const double slack = 8 * kFloatRounding * 2 * kPi;
+  for (const auto& [name, map] : testMaps()) {
+    for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      INFO(name);
+      EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler);
+      kern::EnvmapView view = viewOf(tables);
+      int outside = 0;
+      for (uint32_t i = 0; i < 100000; ++i) {
+        kern::MaRandom4 r = kern::philoxDraw(0xd1ec, 7, 1, 0, i);
+        int t = sampledTexel(view, r);
+        kern::MaVec3 w = kern::sampleEnvmap(view, r);
+        double theta = std::atan2(std::hypot(double(w.x), double(w.y)), double(w.z));
+        double phi = std::atan2(double(w.y), double(w.x));
+        int row = t / tables.width, col = t % tables.width;
+        double thetaLo = kPi * row / tables.height, thetaHi = kPi * (row + 1) / tables.height;
+        // φ from the texel's first edge, wrapped into [−slack, 2π − slack).
+        double dPhi = phi - 2 * kPi * col / tables.width;
+        dPhi -= 2 * kPi * std::floor((dPhi + slack) / (2 * kPi));
+        bool inside = theta >= thetaLo - slack && theta <= thetaHi + slack && dPhi >= -slack &&
+                      dPhi <= 2 * kPi / tables.width + slack;
+        outside += inside ? 0 : 1;
+      }
+      CHECK(outside == 0);
+    }
+  }
+}
+
+TEST_CASE("buildAliasTable reproduces extreme weights and never returns a zero", "[envmap][alias]") {
+  // Weights over 600 orders of magnitude, with zeros, and one bucket holding almost
+  // all of the mass, as a small bright sun does.
+  std::vector<double> weights(100000);
+  for (std::size_t i = 0; i < weights.size(); ++i)
+    weights[i] = i % 3 == 0 ? 0.0 : std::ldexp(1.0 + double(i % 7), int(i % 2001) - 1000);
+  weights[777] = 1e300;
+  misalloc::AliasTable table = misalloc::buildAliasTable(weights);
+  const std::size_t n = weights.size();
+  REQUIRE(table.probability.size() == n);
+  REQUIRE(table.alias.size() == n);
+  double total = 0;
+  for (double w : weights) total += w;
+  std::vector<double> implied(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    REQUIRE(table.alias[i] < n);
+    implied[i] += table.probability[i] / double(n);
+    implied[table.alias[i]] += (1 - double(table.probability[i])) / double(n);
+    if (weights[i] == 0) {
+      CHECK(table.probability[i] == 0.0f);
+      CHECK(weights[table.alias[i]] > 0);
+    }
+  }
+  // Each acceptance probability is rounded to float once, moving at most 2^-24 / N
+  // between a bucket and its alias.
+  std::vector<double> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = weights[i] / total;
+  CHECK(totalVariation(implied, p) <= 2 * kFloatRounding);
+}
+
+TEST_CASE("buildAliasTable rejects weights that are no distribution", "[envmap][alias]") {
+  using misalloc::buildAliasTable;
+  CHECK_THROWS_AS(buildAliasTable({}), std::invalid_argument);
+  CHECK_THROWS_AS(buildAliasTable({0.0, 0.0}), std::invalid_argument);
+  CHECK_THROWS_AS(buildAliasTable({1.0, -1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(buildAliasTable({1.0, std::nan("")}), std::invalid_argument);
+  CHECK_THROWS_AS(buildAliasTable({1.0, std::numeric_limits<double>::infinity()}), std::invalid_argument);
+  CHECK_THROWS_AS(buildAliasTable({1e308, 1e308}), std::invalid_argument);  // the sum overflows
+}
+
+TEST_CASE("makeEnvmap reads an EXR path", "[envmap]") {
+  const std::string path = MISALLOC_SOURCE_DIR "/data/envmaps/lebombo.exr";
+  Envmap map = misalloc::makeEnvmap(path);
+  CHECK(map.image.width == 1024);
+  CHECK(map.image.height == 512);
+  CHECK(map.coskExponent < 0);
+  CHECK_THAT(map.description, Contains("lebombo.exr (1024×512)"));
+}
+
+TEST_CASE("makeEnvmap rasterises constant and cos^K maps", "[envmap]") {
+  Envmap one = misalloc::makeEnvmap("constant");
+  CHECK(one.image.width == 512);
+  CHECK(one.image.height == 256);
+  CHECK(one.coskExponent < 0);
+  CHECK(one.image.rgb == std::vector<float>(512 * 256 * 3, 1.0f));
+  Envmap two = misalloc::makeEnvmap("constant:2.5", 16);
+  CHECK(two.image.rgb == std::vector<float>(16 * 8 * 3, 2.5f));
+  CHECK(two.description == "constant:2.5 (16×8)");
+
+  for (double k : {0.0, 1.0, 7.5}) {
+    INFO("K = " << k);
+    const int width = 64, height = 32;
+    Envmap map = misalloc::makeEnvmap(fmt::format("cosk:{}", k), width);
+    CHECK(map.coskExponent == float(k));
+    for (int row = 0; row < height; ++row) {
+      const float* first = &map.image.rgb[3 * std::size_t(row) * width];
+      CHECK(std::count(first, first + 3 * width, first[0]) == 3 * width);  // grey, constant along the row
+      // The solid-angle average of c^K, c = cos θ, over the row (c from c1 to c0):
+      // ∫ c^K dc / (c0 − c1) = (c0^{K+1} − c1^{K+1}) / ((K+1)(c0 − c1)), with c1 ≥ 0.
+      double c0 = std::cos(kPi * row / height), c1 = std::max(0.0, std::cos(kPi * (row + 1) / height));
+      double exact = row < height / 2 ? (std::pow(c0, k + 1) - std::pow(c1, k + 1)) / ((k + 1) * (c0 - c1)) : 0.0;
+      // The 16-point midpoint rule in c errs by at most (Δc/16)² max|f''| / 24, with
+      // f'' = K(K−1) c^{K−2} largest at c0 for K ≥ 2 and 0 for K = 0 and 1.
+      double step = (c0 - c1) / 16;
+      double ruleError = row < height / 2 && k >= 2 ? step * step / 24 * k * (k - 1) * std::pow(c0, k - 2) : 0.0;
+      CHECK(std::abs(first[0] - exact) <= ruleError + 2 * kFloatRounding * exact);
+    }
+    CHECK(map.image.rgb[3 * std::size_t(height / 2 - 1) * width] > 0.0f);  // the horizon row keeps its upper part
+  }
+}
+
+TEST_CASE("makeEnvmap's sun keeps its power at any size and resolution", "[envmap]") {
+  // The sky depends on θ only, so the texel diametrically opposite in φ holds the sky
+  // without the sun; the excess power over the cap's solid angle is the sun's radiance.
+  auto sunRadiance = [](double radiusDegrees, int width) {
+    Envmap map = misalloc::makeEnvmap(fmt::format("sun:40,90,{},1e5", radiusDegrees), width);
+    const RgbImage& im = map.image;
+    auto luminance = [&](int col, int row) {
+      const float* p = &im.rgb[3 * (std::size_t(row) * im.width + col)];
+      return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    };
+    double excess = 0;
+    for (int row = 0; row < im.height; ++row) {
+      double solidAngle = 2 * kPi / im.width * (std::cos(kPi * row / im.height) - std::cos(kPi * (row + 1) / im.height));
+      for (int col = 0; col < im.width; ++col)
+        excess += (luminance(col, row) - luminance((col + im.width / 2) % im.width, row)) *
+                  (std::abs(col - im.width / 4) < im.width / 4 ? solidAngle : 0.0);
+    }
+    double radius = radiusDegrees * kPi / 180;
+    return excess / (2 * kPi * (1 - std::cos(radius)));
+  };
+  double reference = sunRadiance(0.5, 512);
+  for (auto [radius, width] : {std::pair{0.05, 64}, {0.5, 64}, {3.0, 64}, {0.05, 512}, {3.0, 512}, {0.5, 2048}}) {
+    INFO("radius " << radius << "°, width " << width);
+    // The disc's texels are rounded to float once each.
+    CHECK(sunRadiance(radius, width) == Approx(reference).epsilon(16 * kFloatRounding));
+  }
+
+  const int width = 512, height = 256;
+  Envmap sun = misalloc::makeEnvmap("sun", width);
+  const auto& rgb = sun.image.rgb;
+  auto at = [&](int col, int row, int c) { return rgb[3 * (std::size_t(row) * width + col) + c]; };
+  // The brightest texel is one of those the centre (θ = 40°, φ = 90°) touches.
+  std::size_t brightest = (std::max_element(rgb.begin(), rgb.end()) - rgb.begin()) / 3;
+  CHECK(std::abs((brightest / width + 0.5) * 180.0 / height - 40) <= 180.0 / height);
+  CHECK(std::abs((brightest % width + 0.5) * 360.0 / width - 90) <= 360.0 / width);
+  // The sky is bluish and brighter towards the horizon; the ground is dimmer than any sky.
+  double maxSky = 0;
+  for (int row = 0; row < height / 2; ++row) {
+    CHECK(at(400, row, 2) > at(400, row, 0));
+    if (row > 0) CHECK(at(400, row, 1) > at(400, row - 1, 1));
+    maxSky = std::max(maxSky, 0.2126 * at(400, row, 0) + 0.7152 * at(400, row, 1) + 0.0722 * at(400, row, 2));
+  }
+  for (int row = height / 2; row < height; ++row) CHECK(at(400, row, 1) < at(400, 0, 1));
+  // RATIO is relative to the sky's brightest radiance, at the horizon; the texels
+  // next to it average over π/H of brightness falling at most linearly in 1 − cos θ.
+  CHECK(reference / maxSky >= 1e5);
+  CHECK(reference / maxSky <= 1e5 / (1 - kPi / height));
+}
+
+TEST_CASE("makeEnvmap rejects bad specs, listing the accepted forms", "[envmap]") {
+  for (const char* spec : {"", "cosk", "cosk:", "cosk:-1", "cosk:abc", "cosk:1e50", "constant:-2", "constant:1,2",
+                           "sun:", "sun:1,2,3", "sun:1,2,3,4,5", "sun:200,0,1,10", "sun:40,90,0,10", "sun:40,90,1,0",
+                           "sun:40,90,0.5,1e5x", "sun:40,nan,0.5,10", "no_such_map.exr"}) {
+    INFO(spec);
+    CHECK_THROWS_AS(misalloc::makeEnvmap(spec), misalloc::InputError);
+    CHECK_THROWS_WITH(misalloc::makeEnvmap(spec), Contains("accepted forms") && Contains("cosk:K"));
+  }
+  CHECK_THROWS_WITH(misalloc::makeEnvmap("constant", 1), Contains("width 1"));
+  CHECK_THROWS_AS(misalloc::makeEnvmap("sun", 1 << 20), misalloc::InputError);
+}

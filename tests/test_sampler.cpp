@@ -1,0 +1,73 @@
+// kernels/sample.cl on PoCL against its C++ reference (HostSampler: the same
+// functions compiled by g++), and the determinism of the sampling kernel.
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include <cstring>
+
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+// The two compilers may fuse or order float operations differently, so sums of a
+// pixel's samples agree to float precision relative to the sum of their magnitudes;
+// 1e-4 leaves room for the few hundred samples per pixel that each carry ~1 ulp.
+bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(a) + std::abs(b)) + 1e-30; }
+
+}  // namespace
+
+TEST_CASE("sampleStage on PoCL matches its C++ reference", "[sampler]") {
+  for (bool split : {false, true}) {
+    for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      for (Estimator e : {Estimator::MultiSample, Estimator::OneSample}) {
+        Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s);
+        StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
+        Sampler device(testDevice(), scene, e);
+        HostSampler host(scene, e);
+        StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+        size_t mismatches = 0;
+        for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += !closeSums(a.rgb[i], b.rgb[i]);
+        for (size_t i = 0; i < a.moments.size(); ++i) mismatches += !closeSums(a.moments[i], b.moments[i]);
+        INFO(fmt::format("split {} cdf {} one-sample {}", split, s == EnvmapSampler::Cdf, e == Estimator::OneSample));
+        CHECK(mismatches == 0);
+      }
+    }
+  }
+}
+
+TEST_CASE("same seed, device and options give bit-identical results", "[sampler][determinism]") {
+  Scene scene = smallScene("rooitou_park", "seed000", 40, 24);
+  StagePlan plan = singleStagePlan(scene, Method::Equal, 32);
+  Sampler a(testDevice(), scene, Estimator::MultiSample, 8);
+  Sampler b(testDevice(), scene, Estimator::MultiSample, 16);
+  StageResult r1 = a.run(plan, 5), r2 = a.run(plan, 5), r3 = b.run(plan, 5), r4 = a.run(plan, 6);
+  auto same = [](const std::vector<double>& x, const std::vector<double>& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+  };
+  CHECK(same(r1.rgb, r2.rgb));
+  CHECK(same(r1.moments, r2.moments));
+  CHECK(same(r1.rgb, r3.rgb));  // the work-group size does not change the result
+  CHECK_FALSE(same(r1.rgb, r4.rgb));
+}
+
+TEST_CASE("later stages continue each technique's random stream", "[sampler]") {
+  // Two stages of 32 with the second's first indices after the first's take the same
+  // samples as one stage of 64, so the stage estimates average to the same image.
+  Scene scene = smallScene("forest_slope", "seed000", 16, 16);
+  const int M = scene.techniqueCount(), pixels = scene.pixelCount();
+  Sampler sampler(testDevice(), scene, Estimator::MultiSample);
+  StageResult whole = sampler.run(singleStagePlan(scene, Method::Equal, 64), 9);
+  StagePlan half = singleStagePlan(scene, Method::Equal, 32);
+  StageResult first = sampler.run(half, 9);
+  for (int p = 0; p < pixels; ++p)
+    for (int k = 0; k < M; ++k) half.firstIndex[size_t(p) * M + k] = uint32_t(half.counts[size_t(p) * M + k]);
+  StageResult second = sampler.run(half, 9);
+  size_t mismatches = 0;
+  for (size_t i = 0; i < whole.rgb.size(); ++i)
+    mismatches += !closeSums(whole.rgb[i], 0.5 * (first.rgb[i] + second.rgb[i]));
+  CHECK(mismatches == 0);
+}

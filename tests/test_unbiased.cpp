@@ -1,0 +1,77 @@
+// Every estimator is unbiased: against the closed form 000 eq. 6.17 (envmap cos^K θ,
+// view along the normal) and, where there is none, against each other. Each pixel of a
+// uniform grid is an independent estimate of the same value, so the pixel mean has a
+// known standard error; fixed seeds make every z-score reproducible.
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+// |z| < 4: a false alarm has probability 6e-5 per check for a correct estimator.
+constexpr double kMaxZ = 4.0;
+
+// A zero-variance estimator (f ∝ p) still carries float rounding: each sample's
+// f/(N p) is a float, ~1e-7 relative. The error it is measured against has that floor.
+double zScore(double mean, double expected, double standardError) {
+  return (mean - expected) / std::max(standardError, 1e-6 * std::abs(expected));
+}
+
+double closedForm(double rhoD, double rhoS, double n, double K) {
+  return 2 * rhoD / (K + 2) + rhoS * (n + 2) / (n + K + 2);  // 000 eq. 6.17, R = 1
+}
+
+MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, int spp, uint64_t seed) {
+  Sampler sampler(testDevice(), scene, estimator);
+  StageResult r = sampler.run(singleStagePlan(scene, method, spp), seed);
+  return pixelMean(r.rgb);
+}
+
+}  // namespace
+
+TEST_CASE("every estimator is unbiased against 000 eq. 6.17", "[unbiased]") {
+  struct Case {
+    double rhoD, n, K;
+  };
+  const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {1.0, 1, 0}, {0.05, 100, 0.5}, {0.7, 0.1, 6}};
+  uint64_t seed = 100;
+  for (const Case& c : cases) {
+    const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+    for (bool split : {false, true}) {
+      for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+        Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n),
+                                 32, 32, split, s);
+        for (Method m : {Method::Envmap, Method::Brdf, Method::Equal}) {
+          for (Estimator e : {Estimator::MultiSample, Estimator::OneSample}) {
+            if (m != Method::Equal && e == Estimator::OneSample) continue;  // the same estimator
+            MeanAndError r = renderMean(scene, m, e, 64, ++seed);
+            double z = zScore(r.mean, expected, r.standardError);
+            INFO(fmt::format("rhoD {} n {} K {} split {} cdf {} method {} one-sample {}: mean {} expected {} z {}",
+                             c.rhoD, c.n, c.K, split, s == EnvmapSampler::Cdf, methodName(m),
+                             e == Estimator::OneSample, r.mean, expected, z));
+            CHECK(std::abs(z) < kMaxZ);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("estimators agree on a real envmap and an oblique view", "[unbiased]") {
+  // No closed form: each technique alone and their MIS estimate the same integral.
+  for (double view : {0.0, 60.0, 89.0}) {
+    Scene scene = smallScene("kloofendal_overcast", "uniform:0.3,0.7,20", 32, 32, false, EnvmapSampler::Alias, view);
+    MeanAndError equal = renderMean(scene, Method::Equal, Estimator::MultiSample, 256, 7);
+    for (Method m : {Method::Envmap, Method::Brdf}) {
+      MeanAndError r = renderMean(scene, m, Estimator::MultiSample, 256, 8);
+      double z = zScore(r.mean, equal.mean, std::hypot(r.standardError, equal.standardError));
+      INFO(fmt::format("view {} method {}: {} vs equal {} z {}", view, methodName(m), r.mean, equal.mean, z));
+      CHECK(std::abs(z) < kMaxZ);
+    }
+  }
+}
