@@ -63,13 +63,13 @@ void runStages(benchmark::State& state, StageSampler& sampler, const StagePlan& 
 
 void benchOpenCl(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  Sampler sampler(device(), scene, Estimator::MultiSample);
+  Sampler sampler(device(), scene);
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 
 void benchOpenMp(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  HostSampler sampler(scene, Estimator::MultiSample);
+  HostSampler sampler(scene);
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 

@@ -11,4 +11,5 @@
 namespace misalloc::kern {
 #include "estimator.h"
 #include "pixel.h"
+#include "stats.h"
 }  // namespace misalloc::kern

@@ -8,6 +8,9 @@
 #include "AtomicFile.h"
 #include "Error.h"
 #include "cl/Device.h"
+#include "paper/PaperReport.h"
+#include "render/AlphaMap.h"
+#include "render/Costs.h"
 #include "render/ImageMetrics.h"
 #include "render/Method.h"
 #include "render/Reference.h"
@@ -54,11 +57,18 @@ struct SceneArgs {
   }
 };
 
+// The device is opened once; samplers built on it share it.
 std::unique_ptr<StageSampler> makeSampler(const std::string& deviceSpec, std::unique_ptr<Device>& device,
-                                          const Scene& scene, Estimator estimator, int localSize) {
-  if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, estimator);
-  device = std::make_unique<Device>(openDevice(deviceSpec));
-  return std::make_unique<Sampler>(*device, scene, estimator, localSize);
+                                          const Scene& scene, const SamplerConfig& config, int localSize) {
+  if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, config);
+  if (!device) device = std::make_unique<Device>(openDevice(deviceSpec));
+  return std::make_unique<Sampler>(*device, scene, config, localSize);
+}
+
+ZeroWeightRule parseLinearRule(const std::string& name) {
+  if (name == "variance") return ZeroWeightRule::MinSampleVariance;
+  if (name == "drop") return ZeroWeightRule::DropMostNegative;
+  throw InputError(fmt::format("--linear-rule '{}': expected variance (003 eq. 19) or drop", name));
 }
 
 Estimator parseEstimator(const std::string& name) {
@@ -85,8 +95,18 @@ int main(int argc, char** argv) {
   std::string method = "equal", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
               reportPath = "render.json", referenceMode = "auto", cacheDir = defaultCacheDir();
   renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str();
-  renderCmd->add_option("--method", method, "envmap, brdf or equal")->capture_default_str();
-  renderCmd->add_option("--estimator", estimatorName, "multi (000 eq. 4.1) or one (one-sample MIS)")
+  renderCmd->add_option("--method", method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
+      ->capture_default_str();
+  AdaptiveOptions adaptive;
+  std::string costList, alphaMap, linearRule = "variance";
+  renderCmd->add_option("--pilot", adaptive.pilotFraction, "adaptive methods: the pilot's share of the budget")
+      ->capture_default_str();
+  renderCmd->add_option("--stages", adaptive.stages, "adaptive methods: stages after the pilot")->capture_default_str();
+  renderCmd->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
+  renderCmd->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
+      ->capture_default_str();
+  renderCmd->add_option("--alpha-map", alphaMap, "write the per-pixel allocation: EXR here, false-colour PNG beside");
+  renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi (000 eq. 4.1) or one (one-sample MIS)")
       ->capture_default_str();
   renderCmd->add_option("--seed", seed, "random seed")->capture_default_str();
   renderCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, an index from `misalloc devices`, or host (C++)")
@@ -123,41 +143,69 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("devices")) {
       listDevices(std::cout);
     } else if (app.got_subcommand("paper")) {
-      throw InputError("paper: pending");
+      if (paperId.empty())
+        listPaperExamples(std::cout);
+      else
+        printPaperExample(paperId, std::cout);
     } else if (app.got_subcommand("render")) {
       if (spp < 1) throw InputError(fmt::format("--spp {}: need at least 1 sample per pixel", spp));
       Method m = parseMethod(method);
       Estimator estimator = parseEstimator(estimatorName);
+      if (isAdaptive(m) && estimator != Estimator::MultiSample)
+        throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", estimatorName));
+      adaptive.linearRule = parseLinearRule(linearRule);
       checkWritableOutput(out, "--out");
       checkWritableOutput(reportPath, "--report");
+      if (!alphaMap.empty()) {
+        checkWritableOutput(alphaMap, "--alpha-map");
+        checkWritableOutput(alphaPngPath(alphaMap), "--alpha-map");
+      }
       Scene scene = renderScene.make();
+      if (isAdaptive(m)) stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
+      std::string costSource = "--cost";
+      if (!costList.empty()) adaptive.costs = parseCosts(costList, scene.techniqueCount());
       std::unique_ptr<Device> device;
-      auto sampler = makeSampler(deviceSpec, device, scene, estimator, localSize);
+      SamplerConfig config = samplerConfigFor(m, estimator, spp);
+      auto sampler = makeSampler(deviceSpec, device, scene, config, localSize);
       std::string deviceName = device ? device->name() : "host (C++ reference, OpenMP)";
+      // Without statistics: for the reference and for measuring costs.
+      std::unique_ptr<StageSampler> plain;
+      auto plainSampler = [&]() -> StageSampler& {
+        if (!plain) plain = makeSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
+        return *plain;
+      };
       std::optional<Reference> reference;
       if (referenceMode == "auto")
-        reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
+        reference = findReference(plainSampler(), scene, referenceSpp, cacheDir, true);
       else if (referenceMode != "none")
         reference = Reference{readExr(referenceMode), "file", referenceMode};
       if (reference) checkSameSize(reference->image, RgbImage{scene.grid.width, scene.grid.height, {}});
-      Rendering r = render(*sampler, scene, m, estimator, spp, seed);
-      nlohmann::json report = renderReport({scene, m, estimator, spp, seed, deviceName, r, reference});
+      if (isAdaptive(m) && adaptive.costs.empty()) {
+        adaptive.costs = measureCosts(plainSampler());
+        costSource = "measured";
+      }
+      Rendering r = render(*sampler, m, adaptive, spp, seed);
+      nlohmann::json report =
+          renderReport({scene, m, config.estimator, adaptive, costSource, spp, seed, deviceName, r, reference});
       writeExr(out, r.image);
+      if (!alphaMap.empty()) writeAlphaMaps(alphaMap, scene, r);
       writeFileAtomically(reportPath, report.dump(2) + "\n");
-      std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s)\n", deviceName,
-                               scene.options.envmap, scene.options.grid, scene.grid.width, scene.grid.height, spp,
-                               methodName(m), r.wallSeconds, r.kernelSeconds);
+      std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s, allocation {:.3f} s)\n",
+                               deviceName, scene.options.envmap, scene.options.grid, scene.grid.width,
+                               scene.grid.height, spp, methodName(m), r.wallSeconds, r.kernelSeconds,
+                               r.allocationSeconds);
       if (reference)
         std::cout << fmt::format("RMSE x1000 {:.3f}, relative MSE {:.4g} (reference: {})\n",
                                  report["rmse_x1000"].get<double>(), report["relative_mse"].get<double>(),
                                  reference->source);
-      std::cout << fmt::format("wrote {} and {}\n", out, reportPath);
+      std::cout << fmt::format("wrote {} and {}{}\n", out, reportPath,
+                               alphaMap.empty() ? "" : fmt::format(", {} and {}", alphaMap, alphaPngPath(alphaMap)));
     } else if (app.got_subcommand("reference")) {
       if (referenceSpp < 1) throw InputError("--spp must be at least 1");
       if (!referenceOut.empty()) checkWritableOutput(referenceOut, "--out");
       Scene scene = referenceScene.make();
       std::unique_ptr<Device> device;
-      auto sampler = makeSampler(deviceSpec, device, scene, Estimator::MultiSample, localSize);
+      auto sampler = makeSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
       auto reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
       if (!referenceOut.empty()) writeExr(referenceOut, reference->image);
       std::cout << fmt::format("reference: {}{}\n", reference->source,

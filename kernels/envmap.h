@@ -11,9 +11,9 @@
 // Row 0 is the zenith: texel (col, row) covers φ ∈ 2π[col, col+1)/W and
 // θ ∈ π[row, row+1)/H, with z up.
 typedef struct {
-  MA_GLOBAL const float* texels;        // per texel: R, G, B, probability of the texel
-  MA_GLOBAL const float* samplerTable;  // alias: acceptance probabilities; CDF: marginal (H+1) then conditionals H×(W+1)
-  MA_GLOBAL const ma_uint* aliasIndex;  // alias: the alias of each texel; CDF: unused
+  MA_GLOBAL const float* texels;       // per texel: R, G, B, probability of the texel
+  MA_GLOBAL const float* cdfTable;     // CDF: marginal (H+1) then conditionals H×(W+1)
+  MA_GLOBAL const ma_uint* aliasTable;  // alias: per bucket, acceptance probability bits and alias
   int width, height;
   int useCdf;
   int cdfStepsRow, cdfStepsCol;  // ceil(log2(H)), ceil(log2(W)): fixed-step binary searches
@@ -50,11 +50,13 @@ MA_FN float envmapPdfOfTexel(EnvmapView env, float texelProbability, float sinTh
 MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) {
   int t = texelOfDirection(env, w);
   EnvmapHit hit;
-  float grey = w.z > 0.0f ? fastPow(w.z, env.coskExponent) : 0.0f;
-  int analytic = env.coskExponent >= 0.0f;
-  hit.r = analytic ? grey : env.texels[4 * t + 0];
-  hit.g = analytic ? grey : env.texels[4 * t + 1];
-  hit.b = analytic ? grey : env.texels[4 * t + 2];
+  if (env.coskExponent >= 0.0f) {
+    hit.r = hit.g = hit.b = w.z > 0.0f ? fastPow(w.z, env.coskExponent) : 0.0f;
+  } else {
+    hit.r = env.texels[4 * t + 0];
+    hit.g = env.texels[4 * t + 1];
+    hit.b = env.texels[4 * t + 2];
+  }
   hit.pdf = envmapPdfOfTexel(env, env.texels[4 * t + 3], ma_sqrt(w.x * w.x + w.y * w.y));
   return hit;
 }
@@ -63,7 +65,8 @@ MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) {
 // independent uniform: one 24-bit uniform for both is biased for large tables.
 MA_FN int sampleAliasTable(EnvmapView env, ma_uint bucketBits, float coin) {
   ma_uint bucket = mulHi(bucketBits, (ma_uint)(env.width * env.height));
-  return coin < env.samplerTable[bucket] ? (int)bucket : (int)env.aliasIndex[bucket];
+  float accept = ma_as_float(env.aliasTable[2 * bucket]);
+  return coin < accept ? (int)bucket : (int)env.aliasTable[2 * bucket + 1];
 }
 
 // The last index i in [0, n) with cdf[i] ≤ u, cdf[0] = 0 ≤ u < 1 = cdf[n]: a
@@ -80,9 +83,9 @@ MA_FN int searchCdf(MA_GLOBAL const float* cdf, int n, int steps, float u) {
 }
 
 MA_FN int sampleCdfTable(EnvmapView env, float uRow, float uCol) {
-  MA_GLOBAL const float* marginal = env.samplerTable;
+  MA_GLOBAL const float* marginal = env.cdfTable;
   int row = searchCdf(marginal, env.height, env.cdfStepsRow, uRow);
-  MA_GLOBAL const float* conditional = env.samplerTable + (env.height + 1) + row * (env.width + 1);
+  MA_GLOBAL const float* conditional = env.cdfTable + (env.height + 1) + row * (env.width + 1);
   int col = searchCdf(conditional, env.width, env.cdfStepsCol, uCol);
   return row * env.width + col;
 }

@@ -26,11 +26,11 @@ MA_FN MaVec3 sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int
   return technique == 1 ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
 }
 
-// p_k(ω_i) of every technique, given the envmap's pdf at ω_i.
-MA_FN void techniquePdfs(TechniqueSet ts, PhongParams b, MaVec3 wi, float envmapPdf, float* pdfs) {
+// p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i.
+MA_FN void techniquePdfs(TechniqueSet ts, PhongParams b, MaVec3 wi, float envmapPdf, float lobe, float* pdfs) {
   pdfs[0] = envmapPdf;
-  pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, ts.mirror);
-  pdfs[2] = ts.splitBrdf ? specularPdf(b, wi, ts.mirror) : 0.0f;
+  pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, lobe);
+  pdfs[2] = ts.splitBrdf ? specularPdf(b, lobe) : 0.0f;
 }
 
 // 000 eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
@@ -49,12 +49,13 @@ typedef struct {
 MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi) {
   EnvmapHit hit = envmapLookup(env, wi);
   float cosTheta = ma_max(wi.z, 0.0f);
-  float brdfCos = phongBrdf(b, wi, ts.mirror) * cosTheta;
+  float lobe = phongLobe(b, wi, ts.mirror);
+  float brdfCos = phongBrdf(b, lobe) * cosTheta;
   SampleValue s;
   s.r = hit.r * brdfCos;
   s.g = hit.g * brdfCos;
   s.b = hit.b * brdfCos;
-  techniquePdfs(ts, b, wi, hit.pdf, s.pdfs);
+  techniquePdfs(ts, b, wi, hit.pdf, lobe, s.pdfs);
   return s;
 }
 

@@ -12,10 +12,13 @@ typedef struct {
   float rhoD, rhoS, n;
 } PhongParams;
 
-// f = ρd/π + ρs (n+2)/(2π) cos^n α, with cos^n α = 0 beyond 90° from the mirror.
-MA_FN float phongBrdf(PhongParams b, MaVec3 wi, MaVec3 mirror) {
-  float cosAlpha = dot3(wi, mirror);
-  return b.rhoD * MA_INV_PI + b.rhoS * (b.n + 2.0f) * (0.5f * MA_INV_PI) * fastPow(cosAlpha, b.n);
+// cos^n α, α the angle between ω_i and the mirror direction; 0 beyond 90°. The BRDF
+// and both pdfs share it: it is the costliest term of a sample.
+MA_FN float phongLobe(PhongParams b, MaVec3 wi, MaVec3 mirror) { return fastPow(dot3(wi, mirror), b.n); }
+
+// f = ρd/π + ρs (n+2)/(2π) cos^n α.
+MA_FN float phongBrdf(PhongParams b, float lobe) {
+  return b.rhoD * MA_INV_PI + b.rhoS * (b.n + 2.0f) * (0.5f * MA_INV_PI) * lobe;
 }
 
 // Cosine lobe: p = cos θ / π on the upper hemisphere.
@@ -23,9 +26,7 @@ MA_FN float diffusePdf(MaVec3 wi) { return ma_max(wi.z, 0.0f) * MA_INV_PI; }
 
 // Phong lobe about the mirror direction: p = (n+1)/(2π) cos^n α. Part of it may lie
 // below the horizon; such samples contribute zero but count.
-MA_FN float specularPdf(PhongParams b, MaVec3 wi, MaVec3 mirror) {
-  return (b.n + 1.0f) * (0.5f * MA_INV_PI) * fastPow(dot3(wi, mirror), b.n);
-}
+MA_FN float specularPdf(PhongParams b, float lobe) { return (b.n + 1.0f) * (0.5f * MA_INV_PI) * lobe; }
 
 // The probability of the diffuse lobe in the BRDF×cos technique: its albedo share.
 // A black BRDF samples the cosine lobe so that the pdf stays a density.
@@ -35,9 +36,9 @@ MA_FN float diffuseLobeWeight(PhongParams b) {
 }
 
 // BRDF×cos technique: the albedo-weighted mixture of the two lobes.
-MA_FN float brdfPdf(PhongParams b, MaVec3 wi, MaVec3 mirror) {
+MA_FN float brdfPdf(PhongParams b, MaVec3 wi, float lobe) {
   float wd = diffuseLobeWeight(b);
-  return wd * diffusePdf(wi) + (1.0f - wd) * specularPdf(b, wi, mirror);
+  return wd * diffusePdf(wi) + (1.0f - wd) * specularPdf(b, lobe);
 }
 
 // Orthonormal basis about a unit vector (Duff et al. 2017, branch-free).

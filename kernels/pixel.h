@@ -9,14 +9,17 @@
 
 typedef struct {
   int techniqueCount, stageSamples, oneSample;
+  int countIndependent;             // 002 eq. 26 instead of the balance heuristic
   int n0, n1, n2;                   // this stage's counts (one-sample: expected counts)
   ma_uint first0, first1, first2;   // index of each technique's first sample this stage
 } StageCounts;
 
 typedef struct {
   int technique;
-  float r, g, b;  // f / (N p_α), with p_α = Σ_k α_k p_k, α_k = n_k/N (000 eq. 4.2–4.3)
-  float w;        // Y(f) / p_α: the luminance sample value of the balance heuristic
+  float r, g, b;  // the sample's term of the stage estimate
+  float w;        // its luminance value: Y(f)/p_α (balance), Y(f)/Σ_k p_k (count-independent)
+  float y;        // Y(f)
+  float pdfs[MA_MAX_TECHNIQUES];
 } SampleContribution;
 
 typedef struct {
@@ -49,15 +52,25 @@ MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongP
   MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
   MaVec3 wi = sampleTechnique(ts, env, b, technique, rnd);
   SampleValue s = evaluateSample(ts, env, b, wi);
-  float p = mixturePdf(c.techniqueCount, alpha, s.pdfs);
+  // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k (000 eq. 4.2). Count-independent
+  // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) (002 eq. 26).
+  float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
+  float mix[MA_MAX_TECHNIQUES];
+  MA_UNROLL
+  for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) mix[k] = c.countIndependent ? 1.0f : alpha[k];
+  float p = mixturePdf(c.techniqueCount, mix, s.pdfs);
+  float scale = c.countIndependent ? nt : N;
   // p = 0 only where no technique can sample, so f = 0 there too.
   float invP = p > 0.0f ? 1.0f / p : 0.0f;
   SampleContribution out;
   out.technique = technique;
-  out.r = s.r * invP / N;
-  out.g = s.g * invP / N;
-  out.b = s.b * invP / N;
-  out.w = luminance(s.r, s.g, s.b) * invP;
+  out.r = s.r * invP / scale;
+  out.g = s.g * invP / scale;
+  out.b = s.b * invP / scale;
+  out.y = luminance(s.r, s.g, s.b);
+  out.w = out.y * invP;
+  MA_UNROLL
+  for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) out.pdfs[k] = s.pdfs[k];
   return out;
 }
 

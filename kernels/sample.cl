@@ -4,9 +4,12 @@
 //
 // Compile-time options (sampleKernelOptions in host/render/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
-// MA_COSK (< 0: the texels), MA_ONE_SAMPLE. Constants fold the unused techniques,
-// sampler and estimator away.
-#include "pixel.h"
+// MA_COSK (< 0: the texels), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the running
+// sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the
+// unused techniques, sampler, estimator and statistics away.
+#include "stats.h"
+
+#define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
 
 // The per-pixel sums live in local memory, one row per sum: PoCL then keeps nothing
 // but the loop counter across the barrier, and nothing that its earlier passes could
@@ -15,15 +18,15 @@ enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, S
 
 // Everything one sample needs, re-read from global memory (cached) at each sample for
 // the same reason.
-MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* samplerTable,
-                                       __global const uint* aliasIndex, int width, int height,
+MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
+                                       __global const uint* aliasTable, int width, int height,
                                        __global const float* brdfParams, MaVec3 mirror, __global const int* counts,
                                        __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
                                        int pixel, int j) {
   EnvmapView env;
   env.texels = texels;
-  env.samplerTable = samplerTable;
-  env.aliasIndex = aliasIndex;
+  env.cdfTable = cdfTable;
+  env.aliasTable = aliasTable;
   env.width = width;
   env.height = height;
   env.useCdf = MA_USE_CDF;
@@ -47,6 +50,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   c.techniqueCount = MA_TECHNIQUES;
   c.stageSamples = stageSamples;
   c.oneSample = MA_ONE_SAMPLE;
+  c.countIndependent = MA_COUNT_INDEPENDENT;
   c.n0 = n[0];
   c.n1 = n[1];
   c.n2 = MA_TECHNIQUES > 2 ? n[MA_TECHNIQUES - 1] : 0;
@@ -57,17 +61,21 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
-    __global const float* texels, __global const float* samplerTable, __global const uint* aliasIndex, int width,
+    __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable, int width,
     int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
     __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-    int pixelCount, __global ma_acc* estimate, __global ma_acc* moments) {
+    int pixelCount, __global ma_acc* estimate, __global ma_acc* moments, __global ma_acc* stats,
+    __global float* samples, int samplesBefore, int sampleCapacity) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
+  __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
   // Padding work-items run the loop too: the barrier needs every work-item.
   int pixel = gid < pixelCount ? gid : pixelCount - 1;
   for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
+  // The running sums carry over from earlier stages.
+  for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
   for (int j = 0; j < stageSamples; ++j) {
-    SampleContribution c = sampleOfPixel(texels, samplerTable, aliasIndex, width, height, brdfParams,
+    SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams,
                                          makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
                                          seedLo, seedHi, pixel, j);
     ma_acc w = (ma_acc)c.w, ww = w * w;
@@ -81,6 +89,19 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     if (MA_TECHNIQUES > 2) {
       sums[SUM_W2][lid] += c.technique == 2 ? w : 0;
       sums[SUM_WW2][lid] += c.technique == 2 ? ww : 0;
+    }
+    MA_UNROLL
+    for (int s = 0; s < STAT_SLOTS; ++s) {
+      int perTechnique = MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES);
+      running[s][lid] += c.technique == s / perTechnique ? statValue(MA_STATS, s % perTechnique, c) : 0;
+    }
+    if (MA_STORE_SAMPLES && gid < pixelCount) {
+      int i = samplesBefore + j;
+      samples[storedSampleIndex(pixel, i, 0, sampleCapacity, MA_TECHNIQUES)] = (float)c.technique;
+      samples[storedSampleIndex(pixel, i, 1, sampleCapacity, MA_TECHNIQUES)] = c.y;
+      MA_UNROLL
+      for (int l = 0; l < MA_TECHNIQUES; ++l)
+        samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, MA_TECHNIQUES)] = c.pdfs[l];
     }
     barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
   }
@@ -97,5 +118,6 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       m[4] = sums[SUM_W2][lid];
       m[5] = sums[SUM_WW2][lid];
     }
+    for (int s = 0; s < STAT_SLOTS; ++s) stats[pixel * STAT_SLOTS + s] = running[s][lid];
   }
 }

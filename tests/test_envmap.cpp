@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -14,6 +15,7 @@
 
 #include "Error.h"
 #include "KernelCode.h"
+#include "render/KernelViews.h"
 #include "scene/AliasTable.h"
 #include "scene/Envmap.h"
 #include "scene/EnvmapDistribution.h"
@@ -33,19 +35,8 @@ constexpr double kDoubleRounding = 0x1p-53;
 constexpr double kGrid24 = 0x1p24;  // uniformFloat's values are k / 2^24
 constexpr double kPValueThreshold = 1e-3;
 
-kern::EnvmapView viewOf(const EnvmapTables& tables) {
-  kern::EnvmapView view;
-  view.texels = tables.texels.data();
-  view.samplerTable = tables.samplerTable.data();
-  view.aliasIndex = tables.aliasIndex.data();
-  view.width = tables.width;
-  view.height = tables.height;
-  view.useCdf = tables.useCdf;
-  view.cdfStepsRow = tables.cdfStepsRow;
-  view.cdfStepsCol = tables.cdfStepsCol;
-  view.coskExponent = -1;
-  return view;
-}
+// The view the renderer hands the kernels; the maps here keep their image radiance.
+kern::EnvmapView viewOf(const EnvmapTables& tables) { return misalloc::makeEnvmapView(tables, -1); }
 
 // The texel that kernels/envmap.h's sampleEnvmap picks for these random numbers.
 int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) {
@@ -82,12 +73,22 @@ const std::vector<NamedMap>& testMaps() {
     std::vector<NamedMap> m;
     m.push_back({"1x1", greyMap(1, 1, [](int, int) { return 2.0f; })});
     m.push_back({"2x1", greyMap(2, 1, [](int col, int) { return col == 0 ? 1.0f : 3.0f; })});
-    m.push_back({"single bright texel", greyMap(8, 4, [](int col, int row) { return col == 5 && row == 1 ? 10.0f : 0.0f; })});
-    m.push_back({"black upper hemisphere", greyMap(8, 4, [](int col, int row) { return row < 2 ? 0.0f : 1.0f + col; })});
+    m.push_back(
+        {"single bright texel", greyMap(8, 4, [](int col, int row) { return col == 5 && row == 1 ? 10.0f : 0.0f; })});
+    m.push_back(
+        {"black upper hemisphere", greyMap(8, 4, [](int col, int row) { return row < 2 ? 0.0f : 1.0f + col; })});
     m.push_back({"all black", greyMap(8, 4, [](int, int) { return 0.0f; })});
     // Zero weight at both ends of the rows and columns and in between.
     m.push_back({"zero rows and columns", greyMap(7, 5, [](int col, int row) {
-                   return row == 0 || row == 2 || row == 4 || col == 0 || col == 3 || col == 6 ? 0.0f : float(col + row);
+                   return row == 0 || row == 2 || row == 4 || col == 0 || col == 3 || col == 6 ? 0.0f
+                                                                                               : float(col + row);
+                 })});
+    // Irregular weights whose sums round, a third of them zero, and zero trailing rows
+    // and columns: the prefix sums must still reach exactly 1 where the weights end.
+    m.push_back({"sparse", greyMap(61, 29, [](int col, int row) {
+                   uint32_t hash = uint32_t(col * 7919 + row * 104729) * 2654435761u;
+                   bool zero = hash % 3 == 0 || col >= 58 || row >= 27;
+                   return zero ? 0.0f : float(hash >> 8) / float(1 << 24);
                  })});
     m.push_back({"sun", misalloc::makeEnvmap("sun", 64)});
     m.push_back({"cosk:3", misalloc::makeEnvmap("cosk:3", 64)});
@@ -179,7 +180,7 @@ std::vector<double> kernelTexelDistribution(const EnvmapTables& tables) {
   const std::size_t n = std::size_t(tables.width) * tables.height;
   std::vector<double> p(n, 0.0);
   if (tables.useCdf) {
-    const float* marginal = tables.samplerTable.data();
+    const float* marginal = tables.cdfTable.data();
     for (int row = 0; row < tables.height; ++row) {
       double rowP = (gridCountBelow(marginal[row + 1]) - gridCountBelow(marginal[row])) / kGrid24;
       const float* conditional = marginal + (tables.height + 1) + std::size_t(row) * (tables.width + 1);
@@ -191,9 +192,11 @@ std::vector<double> kernelTexelDistribution(const EnvmapTables& tables) {
   }
   for (std::size_t i = 0; i < n; ++i) {
     double bucketP = aliasBucketProbability(i, n);
-    double accept = std::min(gridCountBelow(tables.samplerTable[i]), kGrid24) / kGrid24;
+    float acceptance;
+    std::memcpy(&acceptance, &tables.aliasTable[2 * i], sizeof acceptance);
+    double accept = std::min(gridCountBelow(acceptance), kGrid24) / kGrid24;
     p[i] += bucketP * accept;
-    p[tables.aliasIndex[i]] += bucketP * (1 - accept);
+    p[tables.aliasTable[2 * i + 1]] += bucketP * (1 - accept);
   }
   return p;
 }
@@ -260,19 +263,21 @@ TEST_CASE("buildEnvmapTables lays out the tables that kernels/envmap.h reads", "
     // Texel (col, row) has weight luminance × sin θ at its centre.
     double luminance0 = 0.2126 * 7 + 0.7152 + 0.0722;
     double weight0 = luminance0 * std::sin(kPi / 6), weight14 = 25 * std::sin(5 * kPi / 6);
-    CHECK(tables.texels[4 * 14 + 3] / tables.texels[3] == Approx(weight14 / weight0).epsilon(4 * kFloatRounding));
+    // The CDF sampler's probabilities are what its float CDFs draw (checked below).
+    if (sampler == EnvmapSampler::Alias)
+      CHECK(tables.texels[4 * 14 + 3] / tables.texels[3] == Approx(weight14 / weight0).epsilon(4 * kFloatRounding));
     if (sampler == EnvmapSampler::Alias) {
       CHECK_FALSE(tables.useCdf);
-      CHECK(tables.samplerTable.size() == 15);
-      CHECK(tables.aliasIndex.size() == 15);
+      CHECK(tables.aliasTable.size() == 2 * 15);
+      CHECK(tables.cdfTable == std::vector<float>{0.0f});
     } else {
       CHECK(tables.useCdf);
-      REQUIRE(tables.samplerTable.size() == 4 + 3 * 6);
-      CHECK(tables.aliasIndex == std::vector<uint32_t>{0});
+      REQUIRE(tables.cdfTable.size() == 4 + 3 * 6);
+      CHECK(tables.aliasTable == std::vector<uint32_t>{0});
       CHECK(tables.cdfStepsRow == 2);
       CHECK(tables.cdfStepsCol == 3);
       for (int row = 0; row <= 3; ++row) {
-        const float* cdf = row == 0 ? &tables.samplerTable[0] : &tables.samplerTable[4 + (row - 1) * 6];
+        const float* cdf = row == 0 ? &tables.cdfTable[0] : &tables.cdfTable[4 + (row - 1) * 6];
         int n = row == 0 ? 3 : 5;
         CHECK(cdf[0] == 0.0f);
         CHECK(cdf[n] == 1.0f);
@@ -294,7 +299,7 @@ TEST_CASE("buildEnvmapTables falls back to uniform sampling only for a black map
     EnvmapTables tables = misalloc::buildEnvmapTables(map, EnvmapSampler::Alias);
     CHECK(tables.uniformFallback == (name == "all black"));
   }
-  EnvmapTables black = misalloc::buildEnvmapTables(greyMap(8, 4, [](int, int) { return 0.0f; }), EnvmapSampler::Cdf);
+  EnvmapTables black = misalloc::buildEnvmapTables(greyMap(8, 4, [](int, int) { return 0.0f; }), EnvmapSampler::Alias);
   for (int row = 0; row < 4; ++row) {
     double expected = std::sin(kPi * (row + 0.5) / 4) / (8 * (2 * std::sin(kPi / 8) + 2 * std::sin(3 * kPi / 8)));
     CHECK(black.texels[4 * (8 * row + 3) + 3] == Approx(expected).epsilon(4 * kFloatRounding));
@@ -305,20 +310,28 @@ TEST_CASE("buildEnvmapTables falls back to uniform sampling only for a black map
 TEST_CASE("buildEnvmapTables rejects maps the kernels cannot index", "[envmap]") {
   Envmap huge;
   huge.image.width = 32768;
-  huge.image.height = 16384;
-  huge.image.rgb.resize(3);  // the size check comes first; no need to allocate
+  huge.image.height = 16384;  // 2^29 texels, 2^31 floats: one past the kernels' int range
   huge.description = "huge.exr";
-  CHECK_THROWS_AS(misalloc::buildEnvmapTables(huge, EnvmapSampler::Alias), std::invalid_argument);
+  CHECK_THROWS_AS(misalloc::buildEnvmapTables(huge, EnvmapSampler::Alias), misalloc::InputError);
+  CHECK_THROWS_WITH(misalloc::buildEnvmapTables(huge, EnvmapSampler::Alias),
+                    Contains("huge.exr") && Contains("too many"));
+  Envmap empty;
+  CHECK_THROWS_AS(misalloc::buildEnvmapTables(empty, EnvmapSampler::Alias), std::invalid_argument);
   Envmap negative = greyMap(2, 1, [](int col, int) { return col == 0 ? 1.0f : -1.0f; });
   CHECK_THROWS_AS(misalloc::buildEnvmapTables(negative, EnvmapSampler::Cdf), std::invalid_argument);
 }
 
-TEST_CASE("texel probabilities sum to 1 and both samplers share them", "[envmap]") {
+TEST_CASE("texel probabilities sum to 1 and both samplers' agree", "[envmap]") {
   for (const auto& [name, map] : testMaps()) {
     INFO(name);
     EnvmapTables alias = misalloc::buildEnvmapTables(map, EnvmapSampler::Alias);
     EnvmapTables cdf = misalloc::buildEnvmapTables(map, EnvmapSampler::Cdf);
-    CHECK(alias.texels == cdf.texels);
+    for (std::size_t i = 0; i < alias.texels.size(); ++i)
+      if (i % 4 != 3) CHECK(alias.texels[i] == cdf.texels[i]);
+    // The CDF sampler stores what its float CDFs draw: one float rounding and one 2^-24
+    // grid step per CDF value away from the weights' probabilities.
+    CHECK(totalVariation(texelProbabilities(alias), texelProbabilities(cdf)) <=
+          3 * kFloatRounding * (alias.width + alias.height));
     std::vector<double> p = texelProbabilities(alias);
     double sum = 0;
     for (double x : p) sum += x;
@@ -379,14 +392,15 @@ TEST_CASE("the kernels' samplers draw texels with the stored probabilities, neve
       EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler);
       std::vector<double> p = texelProbabilities(tables);
 
-      // Exactly, over every value of the random numbers. Each stored CDF value and
-      // acceptance probability is off by at most one float rounding and one step of
-      // the 2^-24 grid; a CDF texel depends on two such values, its row's and its
-      // own; and mul_hi's buckets are uniform only when N divides 2^32.
+      // Exactly, over every value of the random numbers. The CDF sampler stores the
+      // probabilities it draws, rounded to float once. Each acceptance probability is
+      // off by at most one float rounding and one step of the 2^-24 grid, and
+      // mul_hi's buckets are uniform only when N divides 2^32.
       std::vector<double> exact = kernelTexelDistribution(tables);
       double bucketBias = 0;
-      for (std::size_t i = 0; i < p.size(); ++i) bucketBias += std::abs(aliasBucketProbability(i, p.size()) - 1.0 / p.size());
-      double bound = cdf ? 3 * kFloatRounding * (tables.width + tables.height) : 3 * kFloatRounding + bucketBias;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        bucketBias += std::abs(aliasBucketProbability(i, p.size()) - 1.0 / p.size());
+      double bound = cdf ? kFloatRounding : 3 * kFloatRounding + bucketBias;
       CHECK(totalVariation(exact, p) <= bound);
       for (std::size_t t = 0; t < p.size(); ++t)
         if (p[t] == 0) CHECK(exact[t] == 0);
@@ -529,7 +543,8 @@ TEST_CASE("makeEnvmap's sun keeps its power at any size and resolution", "[envma
     };
     double excess = 0;
     for (int row = 0; row < im.height; ++row) {
-      double solidAngle = 2 * kPi / im.width * (std::cos(kPi * row / im.height) - std::cos(kPi * (row + 1) / im.height));
+      double solidAngle =
+          2 * kPi / im.width * (std::cos(kPi * row / im.height) - std::cos(kPi * (row + 1) / im.height));
       for (int col = 0; col < im.width; ++col)
         excess += (luminance(col, row) - luminance((col + im.width / 2) % im.width, row)) *
                   (std::abs(col - im.width / 4) < im.width / 4 ? solidAngle : 0.0);

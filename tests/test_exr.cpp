@@ -1,11 +1,11 @@
 // readExr / writeExr / writeExrChannels: round trips, the shipped maps, and every
 // kind of bad input giving an InputError that names the file and the problem.
+#include <Imath/half.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
-#include <Imath/half.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -50,9 +50,7 @@ std::string fileBytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-void writeBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+void writeBytes(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 RgbImage testImage(int width, int height) {
   RgbImage image{width, height, std::vector<float>(std::size_t(width) * height * 3)};
@@ -139,8 +137,8 @@ TEST_CASE("readExr reads the shipped maps as stats.json describes them", "[exr]"
     // The solid-angle weighted mean luminance, with the exact texel solid angles.
     double power = 0;
     for (int row = 0; row < image.height; ++row) {
-      double solidAngle = 2 * kPi / image.width *
-                          (std::cos(kPi * row / image.height) - std::cos(kPi * (row + 1) / image.height));
+      double solidAngle =
+          2 * kPi / image.width * (std::cos(kPi * row / image.height) - std::cos(kPi * (row + 1) / image.height));
       for (int col = 0; col < image.width; ++col) {
         const float* p = &image.rgb[3 * (std::size_t(row) * image.width + col)];
         power += (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) * solidAngle;
@@ -288,7 +286,8 @@ TEST_CASE("writeExrChannels writes named float planes", "[exr]") {
   file.readPixels(window.min.y, window.max.y);
   CHECK(back == planes);
 
-  CHECK_THROWS_AS(misalloc::writeExrChannels(dir / "bad.exr", width, height, names, {planes[0]}), std::invalid_argument);
+  CHECK_THROWS_AS(misalloc::writeExrChannels(dir / "bad.exr", width, height, names, {planes[0]}),
+                  std::invalid_argument);
   CHECK_THROWS_AS(misalloc::writeExrChannels(dir / "bad.exr", width, height, {"a", "a"}, {planes[0], planes[1]}),
                   std::invalid_argument);
   planes[2].pop_back();

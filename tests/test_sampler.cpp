@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 
@@ -21,18 +22,36 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 }  // namespace
 
 TEST_CASE("sampleStage on PoCL matches its C++ reference", "[sampler]") {
+  const SamplerConfig configs[] = {
+      {Estimator::MultiSample, 0, 0},
+      {Estimator::OneSample, 0, 0},
+      {Estimator::CountIndependent, MA_STATS_BALANCE, 0},
+      {Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 100},
+  };
   for (bool split : {false, true}) {
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
-      for (Estimator e : {Estimator::MultiSample, Estimator::OneSample}) {
+      for (const SamplerConfig& config : configs) {
         Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s);
         StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
-        Sampler device(testDevice(), scene, e);
-        HostSampler host(scene, e);
-        StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+        Sampler device(testDevice(), scene, config);
+        HostSampler host(scene, config);
         size_t mismatches = 0;
-        for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += !closeSums(a.rgb[i], b.rgb[i]);
-        for (size_t i = 0; i < a.moments.size(); ++i) mismatches += !closeSums(a.moments[i], b.moments[i]);
-        INFO(fmt::format("split {} cdf {} one-sample {}", split, s == EnvmapSampler::Cdf, e == Estimator::OneSample));
+        // Two stages, so that the running sums and stored samples carry over.
+        for (int stage = 0; stage < 2; ++stage) {
+          plan.samplesBefore = 50 * stage;
+          for (size_t i = 0; i < plan.firstIndex.size(); ++i) plan.firstIndex[i] = uint32_t(plan.counts[i] * stage);
+          StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+          for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += !closeSums(a.rgb[i], b.rgb[i]);
+          for (size_t i = 0; i < a.moments.size(); ++i) mismatches += !closeSums(a.moments[i], b.moments[i]);
+        }
+        std::vector<double> statsA = device.statistics(), statsB = host.statistics();
+        REQUIRE(statsA.size() == statsB.size());
+        for (size_t i = 0; i < statsA.size(); ++i) mismatches += !closeSums(statsA[i], statsB[i]);
+        std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
+        REQUIRE(storedA.size() == storedB.size());
+        for (size_t i = 0; i < storedA.size(); ++i) mismatches += !closeSums(storedA[i], storedB[i]);
+        INFO(fmt::format("split {} cdf {} estimator {} stats {} stored {}", split, s == EnvmapSampler::Cdf,
+                         int(config.estimator), config.statsMask, config.sampleCapacity));
         CHECK(mismatches == 0);
       }
     }
@@ -42,8 +61,8 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference", "[sampler]") {
 TEST_CASE("same seed, device and options give bit-identical results", "[sampler][determinism]") {
   Scene scene = smallScene("rooitou_park", "seed000", 40, 24);
   StagePlan plan = singleStagePlan(scene, Method::Equal, 32);
-  Sampler a(testDevice(), scene, Estimator::MultiSample, 8);
-  Sampler b(testDevice(), scene, Estimator::MultiSample, 16);
+  Sampler a(testDevice(), scene, {}, 8);
+  Sampler b(testDevice(), scene, {}, 16);
   StageResult r1 = a.run(plan, 5), r2 = a.run(plan, 5), r3 = b.run(plan, 5), r4 = a.run(plan, 6);
   auto same = [](const std::vector<double>& x, const std::vector<double>& y) {
     return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
@@ -59,7 +78,7 @@ TEST_CASE("later stages continue each technique's random stream", "[sampler]") {
   // samples as one stage of 64, so the stage estimates average to the same image.
   Scene scene = smallScene("forest_slope", "seed000", 16, 16);
   const int M = scene.techniqueCount(), pixels = scene.pixelCount();
-  Sampler sampler(testDevice(), scene, Estimator::MultiSample);
+  Sampler sampler(testDevice(), scene);
   StageResult whole = sampler.run(singleStagePlan(scene, Method::Equal, 64), 9);
   StagePlan half = singleStagePlan(scene, Method::Equal, 32);
   StageResult first = sampler.run(half, 9);

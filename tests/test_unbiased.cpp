@@ -27,7 +27,7 @@ double closedForm(double rhoD, double rhoS, double n, double K) {
 }
 
 MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, int spp, uint64_t seed) {
-  Sampler sampler(testDevice(), scene, estimator);
+  Sampler sampler(testDevice(), scene, {estimator, 0, 0});
   StageResult r = sampler.run(singleStagePlan(scene, method, spp), seed);
   return pixelMean(r.rgb);
 }

@@ -1,6 +1,6 @@
+#pragma once
 // The result every allocation rule returns, and what the rules share: equal weights,
 // cost validation and the checks that decide whether a pixel's sums can be used.
-#pragma once
 
 #include <optional>
 #include <vector>
@@ -11,24 +11,24 @@ namespace misalloc {
 
 // Why an allocation departed from its formula. Bits, so one pixel can report several.
 enum AllocationFallback : unsigned {
-    kFallbackNone = 0,
-    kFallbackNonFinite = 1u << 0,         // NaN or ∞ in the sums: equal weights
-    kFallbackTooFewSamples = 1u << 1,     // a technique has fewer samples than the estimate needs: equal weights
-    kFallbackNoSignal = 1u << 2,          // every sample of the pixel has f = 0: equal weights
-    kFallbackSilentTechnique = 1u << 3,   // a technique saw only f = 0: its weight is 0
-    kFallbackZeroVariance = 1u << 4,      // a variance estimate is 0: the formula's limit is used
-    kFallbackInfiniteVariance = 1u << 5,  // every technique's variance is infinite: equal weights
-    kFallbackSingularSystem = 1u << 6,    // 003 eq. 14 has no unique solution: equal weights over the active set
+  kFallbackNone = 0,
+  kFallbackNonFinite = 1u << 0,         // NaN or ∞ in the sums: equal weights
+  kFallbackTooFewSamples = 1u << 1,     // a technique has fewer samples than the estimate needs: equal weights
+  kFallbackNoSignal = 1u << 2,          // every sample of the pixel has f = 0: equal weights
+  kFallbackSilentTechnique = 1u << 3,   // a technique saw only f = 0: its weight is 0
+  kFallbackZeroVariance = 1u << 4,      // a variance estimate is 0: the formula's limit is used
+  kFallbackInfiniteVariance = 1u << 5,  // every technique's variance is infinite: equal weights
+  kFallbackSingularSystem = 1u << 6,    // 003 eq. 14 has no unique solution: equal weights over the active set
 };
 
 struct Allocation {
-    std::vector<double> alpha;  // α_k ≥ 0, Σ α_k = 1
-    unsigned fallbacks = kFallbackNone;
-    // Weights the linear heuristic set to 0 by 003 Sec. 5.1. Part of that rule, not a
-    // fallback; counted because a negative raw solution flags a boundary optimum.
-    int zeroedWeights = 0;
+  std::vector<double> alpha;  // α_k ≥ 0, Σ α_k = 1
+  unsigned fallbacks = kFallbackNone;
+  // Weights the linear heuristic set to 0 by 003 Sec. 5.1. Part of that rule, not a
+  // fallback; counted because a negative raw solution flags a boundary optimum.
+  int zeroedWeights = 0;
 
-    bool usedFallback() const { return fallbacks != kFallbackNone; }
+  bool usedFallback() const { return fallbacks != kFallbackNone; }
 };
 
 // α_k = 1/M: Veach's equal sample budgets, the baseline of all three papers.

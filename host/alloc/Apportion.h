@@ -1,5 +1,5 @@
-// From weights α to integer sample counts.
 #pragma once
+// From weights α to integer sample counts.
 
 #include <vector>
 

@@ -1,5 +1,5 @@
-// Havran & Sbert's inverse-variance heuristic (000 Sec. 4.3).
 #pragma once
+// Havran & Sbert's inverse-variance heuristic (000 Sec. 4.3).
 
 #include <vector>
 

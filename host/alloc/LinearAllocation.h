@@ -1,6 +1,6 @@
+#pragma once
 // Szirmay-Kalos & Sbert's linear heuristic (003 Sec. 5): weights from a linear
 // equation in the running sums P_ik and F_k of 003 eq. 18.
-#pragma once
 
 #include <optional>
 #include <vector>
@@ -12,9 +12,9 @@ namespace misalloc {
 
 // 003 Sec. 5.1: what to do when eq. 14's solution has a negative weight.
 enum class ZeroWeightRule {
-    DropMostNegative,   // first technique: zero the most negative weight, re-solve, repeat
-    MinSampleVariance,  // second technique: zero each weight in turn (then pairs, ...) and keep
-                        // the feasible solution with the smallest sample variance (eq. 19)
+  DropMostNegative,   // first technique: zero the most negative weight, re-solve, repeat
+  MinSampleVariance,  // second technique: zero each weight in turn (then pairs, ...) and keep
+                      // the feasible solution with the smallest sample variance (eq. 19)
 };
 
 // 003 eq. 17 for the techniques i, j alone: α_i, with α_j = 1 − α_i. nullopt if the

@@ -1,6 +1,6 @@
+#pragma once
 // Every sample of one pixel, kept per technique, for the estimator that needs more
 // than running sums: the sample variance of 003 eq. 19.
-#pragma once
 
 #include <vector>
 
@@ -9,24 +9,24 @@
 namespace misalloc {
 
 struct StoredSample {
-    double f;                     // f(X)
-    double pdf[kMaxTechniques];   // p_i(X) for every technique i
+  double f;                    // f(X)
+  double pdf[kMaxTechniques];  // p_i(X) for every technique i
 };
 
 class PixelSamples {
-  public:
-    explicit PixelSamples(int techniqueCount);
+ public:
+  explicit PixelSamples(int techniqueCount);
 
-    // Same contract as PixelStats::add; a rejected sample is not stored either.
-    bool add(int k, double f, const double* pdfs);
+  // Same contract as PixelStats::add; a rejected sample is not stored either.
+  bool add(int k, double f, const double* pdfs);
 
-    int techniqueCount() const { return stats_.techniqueCount; }
-    const PixelStats& stats() const { return stats_; }
-    const std::vector<StoredSample>& samples(int k) const { return samples_[k]; }
+  int techniqueCount() const { return stats_.techniqueCount; }
+  const PixelStats& stats() const { return stats_; }
+  const std::vector<StoredSample>& samples(int k) const { return samples_[k]; }
 
-  private:
-    PixelStats stats_;
-    std::vector<StoredSample> samples_[kMaxTechniques];
+ private:
+  PixelStats stats_;
+  std::vector<StoredSample> samples_[kMaxTechniques];
 };
 
 // 003 eq. 19: the sample estimate of the multi-sample balance-heuristic variance

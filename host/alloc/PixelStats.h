@@ -1,5 +1,5 @@
-// Running per-pixel sums from which the allocation rules estimate their statistics.
 #pragma once
+// Running per-pixel sums from which the allocation rules estimate their statistics.
 
 namespace misalloc {
 
@@ -9,13 +9,13 @@ inline constexpr int kMaxTechniques = 4;
 // Sums over the samples X_kj drawn from one technique k. Every field is a double so
 // the struct is a flat block of doubles that a kernel can accumulate in place.
 struct TechniqueStats {
-    double count = 0;        // n_k
-    double sumW = 0;         // Σ w, w = f / p_k: the single-technique estimator of 000 eq. 4.18
-    double sumW2 = 0;        // Σ w²
-    double sumBalance = 0;   // Σ b, b = f / Σ_l p_l: the F_ij of 002 eq. 27
-    double sumBalance2 = 0;  // Σ b²
-    double sumF = 0;         // F_k = Σ_j f(X_kj) (003 eq. 18)
-    double sumPdf[kMaxTechniques] = {};  // sumPdf[i] = P_ik = Σ_j p_i(X_kj) (003 eq. 18)
+  double count = 0;                    // n_k
+  double sumW = 0;                     // Σ w, w = f / p_k: the single-technique estimator of 000 eq. 4.18
+  double sumW2 = 0;                    // Σ w²
+  double sumBalance = 0;               // Σ b, b = f / Σ_l p_l: the F_ij of 002 eq. 27
+  double sumBalance2 = 0;              // Σ b²
+  double sumF = 0;                     // F_k = Σ_j f(X_kj) (003 eq. 18)
+  double sumPdf[kMaxTechniques] = {};  // sumPdf[i] = P_ik = Σ_j p_i(X_kj) (003 eq. 18)
 };
 
 // 000 eq. 6.19: the unbiased sample variance from running sums. Cancellation in
@@ -28,22 +28,22 @@ double sampleVariance(double sum, double sumSquares, double count);
 bool isZeroVariance(double variance, double mean);
 
 struct PixelStats {
-    // Throws std::invalid_argument unless 1 ≤ techniqueCount ≤ kMaxTechniques.
-    explicit PixelStats(int techniqueCount);
+  // Throws std::invalid_argument unless 1 ≤ techniqueCount ≤ kMaxTechniques.
+  explicit PixelStats(int techniqueCount);
 
-    // Adds one sample X drawn from technique k with value f = f(X) and pdfs[i] = p_i(X)
-    // for every technique i. A sample that would poison the sums (non-finite f or pdf,
-    // a negative pdf, or f ≠ 0 where p_k(X) = 0, which has no finite weight) is not
-    // added; it is counted in rejectedCount and add returns false. Both quotients are
-    // taken as 0 where f = 0, so a failed sample (f = 0, p = 0) still counts.
-    bool add(int k, double f, const double* pdfs);
+  // Adds one sample X drawn from technique k with value f = f(X) and pdfs[i] = p_i(X)
+  // for every technique i. A sample that would poison the sums (non-finite f or pdf,
+  // a negative pdf, or f ≠ 0 where p_k(X) = 0, which has no finite weight) is not
+  // added; it is counted in rejectedCount and add returns false. Both quotients are
+  // taken as 0 where f = 0, so a failed sample (f = 0, p = 0) still counts.
+  bool add(int k, double f, const double* pdfs);
 
-    // False if any sum is NaN or infinite, e.g. in sums read back from a device.
-    bool isFinite() const;
+  // False if any sum is NaN or infinite, e.g. in sums read back from a device.
+  bool isFinite() const;
 
-    int techniqueCount;
-    TechniqueStats technique[kMaxTechniques];
-    double rejectedCount = 0;
+  int techniqueCount;
+  TechniqueStats technique[kMaxTechniques];
+  double rejectedCount = 0;
 };
 
 }  // namespace misalloc

@@ -1,5 +1,5 @@
-// Sample counts for the estimator with count-independent weights (002 Sec. 4).
 #pragma once
+// Sample counts for the estimator with count-independent weights (002 Sec. 4).
 
 #include <vector>
 

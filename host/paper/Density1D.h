@@ -1,5 +1,5 @@
-// A probability density on an interval, given by its shape and normalisation.
 #pragma once
+// A probability density on an interval, given by its shape and normalisation.
 
 #include <functional>
 #include <string>
@@ -7,28 +7,26 @@
 
 namespace misalloc {
 
-inline constexpr double kPi = 3.14159265358979323846;
-
 using Function1D = std::function<double(double)>;
 
 class Density1D {
-  public:
-    // p = h / ∫_a^b h, the integral computed by adaptive quadrature.
-    Density1D(std::string name, Function1D shape, double a, double b);
-    // p = h / s with s given: 000 App. C rounds ∫(x² − x/π) to 8.764 and uses that.
-    Density1D(std::string name, Function1D shape, double a, double b, double normalisation);
+ public:
+  // p = h / ∫_a^b h, the integral computed by adaptive quadrature.
+  Density1D(std::string name, Function1D shape, double a, double b);
+  // p = h / s with s given: 000 App. C rounds ∫(x² − x/π) to 8.764 and uses that.
+  Density1D(std::string name, Function1D shape, double a, double b, double normalisation);
 
-    double operator()(double x) const { return shape_(x) / normalisation_; }
-    const Function1D& shape() const { return shape_; }
-    double normalisation() const { return normalisation_; }
-    double lower() const { return a_; }
-    double upper() const { return b_; }
-    const std::string& name() const { return name_; }
+  double operator()(double x) const { return shape_(x) / normalisation_; }
+  const Function1D& shape() const { return shape_; }
+  double normalisation() const { return normalisation_; }
+  double lower() const { return a_; }
+  double upper() const { return b_; }
+  const std::string& name() const { return name_; }
 
-  private:
-    std::string name_;
-    Function1D shape_;
-    double a_, b_, normalisation_;
+ private:
+  std::string name_;
+  Function1D shape_;
+  double a_, b_, normalisation_;
 };
 
 // 000 eq. 4.3: the mixture p_α(x) = Σ_k α_k p_k(x), the density of balance-heuristic MIS.

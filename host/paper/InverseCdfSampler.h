@@ -1,7 +1,7 @@
+#pragma once
 // Inverse-CDF sampling of a 1D density: a tabulated CDF locates the cell, Newton's
 // method on the exact cell integral finds the point, so samples follow the density
 // itself rather than a piecewise approximation of it.
-#pragma once
 
 #include <vector>
 
@@ -10,20 +10,20 @@
 namespace misalloc {
 
 class InverseCdfSampler {
-  public:
-    // Throws std::domain_error if the shape is negative anywhere it is probed: such a
-    // "density" cannot be sampled (000 App. C's x² − x/π on [0, 1/π]).
-    explicit InverseCdfSampler(const Density1D& density);
+ public:
+  // Throws std::domain_error if the shape is negative anywhere it is probed: such a
+  // "density" cannot be sampled (000 App. C's x² − x/π on [0, 1/π]).
+  explicit InverseCdfSampler(const Density1D& density);
 
-    // The point x with CDF(x) = u, for u in [0, 1).
-    double sample(double u) const;
+  // The point x with CDF(x) = u, for u in [0, 1).
+  double sample(double u) const;
 
-  private:
-    double cellIntegral(int cell, double x) const;
+ private:
+  double cellIntegral(int cell, double x) const;
 
-    Function1D shape_;
-    double a_, width_;
-    std::vector<double> cumulative_;  // ∫ shape from a to the start of each cell, and the total
+  Function1D shape_;
+  double a_, width_;
+  std::vector<double> cumulative_;  // ∫ shape from a to the start of each cell, and the total
 };
 
 }  // namespace misalloc

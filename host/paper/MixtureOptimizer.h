@@ -1,5 +1,5 @@
-// The best mixture weights of a 1D example: what the allocation heuristics approximate.
 #pragma once
+// The best mixture weights of a 1D example: what the allocation heuristics approximate.
 
 #include <vector>
 
@@ -9,17 +9,17 @@
 namespace misalloc {
 
 enum class VarianceModel {
-    OneSample,    // 002 eq. 35: the technique of each sample is drawn with probabilities α
-    MultiSample,  // 002 eq. 21: deterministic counts n_k = α_k N
+  OneSample,    // 002 eq. 35: the technique of each sample is drawn with probabilities α
+  MultiSample,  // 002 eq. 21: deterministic counts n_k = α_k N
 };
 
 VarianceValue mixtureVariance(const Example1D& example, VarianceModel model, const std::vector<double>& alpha);
 
 struct OptimalMixture {
-    std::vector<double> alpha;
-    double variance;      // V(α)
-    double inefficiency;  // (Σ_k c_k α_k) · V(α): cost × variance, the inverse of efficiency
-    bool converged;
+  std::vector<double> alpha;
+  double variance;      // V(α)
+  double inefficiency;  // (Σ_k c_k α_k) · V(α): cost × variance, the inverse of efficiency
+  bool converged;
 };
 
 // Minimises (Σ_k c_k α_k)·V(α) over the simplex by the nonmonotone spectral projected
@@ -31,11 +31,11 @@ struct OptimalMixture {
 OptimalMixture minimiseInefficiency(const Example1D& example, VarianceModel model, const std::vector<double>& costs);
 
 struct GridMinimum {
-    std::vector<double> alpha;
-    double variance;
-    int points;           // grid points visited
-    int notADensity;      // skipped: the mixture is negative somewhere (SignedDensity or Undefined)
-    int infiniteVariance; // skipped: V(α) = ∞
+  std::vector<double> alpha;
+  double variance;
+  int points;            // grid points visited
+  int notADensity;       // skipped: the mixture is negative somewhere (SignedDensity or Undefined)
+  int infiniteVariance;  // skipped: V(α) = ∞
 };
 
 // The minimum of V over the α whose components are multiples of 1/divisions, as 000

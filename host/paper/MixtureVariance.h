@@ -1,5 +1,5 @@
-// Exact (quadrature) variances of balance-heuristic MIS on a 1D example, N = 1.
 #pragma once
+// Exact (quadrature) variances of balance-heuristic MIS on a 1D example, N = 1.
 
 #include <vector>
 
@@ -8,23 +8,24 @@
 namespace misalloc {
 
 struct VarianceValue {
-    double value;  // +∞ if Infinite, NaN if Undefined; the formal integral if SignedDensity
-    VarianceStatus status;
+  double value;  // +∞ if Infinite, NaN if Undefined; the formal integral if SignedDensity
+  VarianceStatus status;
 };
 
 // The integrals of f against the mixture p_α that the variance formulas are built from.
 struct MixtureMoments {
-    VarianceStatus status;
-    double secondMoment;                         // λ = ∫ f²/p_α (000 eq. 4.11)
-    std::vector<double> techniqueSecondMoment;   // E_j = ∫ f² p_j / p_α² (000 eq. 4.9)
-    std::vector<double> techniqueMean;           // m_i = ∫ f p_i / p_α (003 eq. 5; μ_i/α_i of 002 eq. 22)
-    std::vector<double> crossMoment;             // B_ij = ∫ f p_i p_j / p_α², row-major, if asked for
+  VarianceStatus status;
+  double secondMoment;                        // λ = ∫ f²/p_α (000 eq. 4.11)
+  std::vector<double> techniqueSecondMoment;  // E_j = ∫ f² p_j / p_α² (000 eq. 4.9)
+  std::vector<double> techniqueMean;          // m_i = ∫ f p_i / p_α (003 eq. 5; μ_i/α_i of 002 eq. 22)
+  std::vector<double> crossMoment;            // B_ij = ∫ f p_i p_j / p_α², row-major, if asked for
 };
 
 // All moments in one adaptive quadrature, after SecondMomentCheck has decided that they
 // exist: +∞ for Infinite, NaN for Undefined. Throws std::runtime_error if the quadrature
 // of a valid mixture does not converge.
-MixtureMoments mixtureMoments(const Example1D& example, const std::vector<double>& alpha, bool withCrossMoments = false);
+MixtureMoments mixtureMoments(const Example1D& example, const std::vector<double>& alpha,
+                              bool withCrossMoments = false);
 
 // 002 eq. 35 (000 eq. 4.5): one-sample balance heuristic, λ − I².
 VarianceValue oneSampleVariance(const MixtureMoments& moments, double integral);
@@ -41,6 +42,10 @@ VarianceValue techniqueVariance(const Example1D& example, int k);
 // 002 eq. 44: V[𝓕¹] − V[F¹] = Σ_i μ_i²/α_i − I², the price of choosing the technique
 // at random.
 double oneSampleExcess(const MixtureMoments& moments, const std::vector<double>& alpha, double integral);
+
+// (Σ_k c_k α_k)·V: cost × variance per sample, the inverse of efficiency (000 Sec. 4.2,
+// 002 Sec. 2.1). Relative efficiencies in the papers are ratios of it.
+double inefficiency(const std::vector<double>& costs, const std::vector<double>& alpha, double variance);
 
 // 002 eq. 28: σ_i of the estimator with count-independent weights p_i/Σ_k p_k (eq. 26).
 std::vector<double> countIndependentSigmas(const Example1D& example);

@@ -1,5 +1,5 @@
-// The 1D examples of papers 000 (App. C), 002 (App. A) and 003 (Sec. 6.1).
 #pragma once
+// The 1D examples of papers 000 (App. C), 002 (App. A) and 003 (Sec. 6.1).
 
 #include <string>
 #include <vector>

@@ -11,8 +11,8 @@ namespace misalloc {
 kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   kern::EnvmapView env;
   env.texels = t.texels.data();
-  env.samplerTable = t.samplerTable.data();
-  env.aliasIndex = t.aliasIndex.data();
+  env.cdfTable = t.cdfTable.data();
+  env.aliasTable = t.aliasTable.data();
   env.width = t.width;
   env.height = t.height;
   env.useCdf = t.useCdf ? 1 : 0;
@@ -22,14 +22,21 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   return env;
 }
 
+HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
+    : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
+  if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
+}
+
 StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
+  if (config_.sampleCapacity > 0 && plan.samplesBefore + plan.stageSamples > config_.sampleCapacity)
+    throw std::logic_error("stage overflows the stored-samples buffer");
   kern::EnvmapView env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
   kern::TechniqueSet ts;
   ts.techniqueCount = M;
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
   ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
-  const int oneSample = estimator_ == Estimator::OneSample ? 1 : 0;
+  const int slots = statSlots(), perTechnique = MA_STATS_PER_TECHNIQUE(int(config_.statsMask), M);
   StageResult result;
   result.rgb.assign(size_t(pixels) * 3, 0.0);
   result.moments.assign(size_t(pixels) * M * 2, 0.0);
@@ -46,7 +53,8 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
     kern::StageCounts c;
     c.techniqueCount = M;
     c.stageSamples = plan.stageSamples;
-    c.oneSample = oneSample;
+    c.oneSample = config_.estimator == Estimator::OneSample;
+    c.countIndependent = config_.estimator == Estimator::CountIndependent;
     c.n0 = n[0];
     c.n1 = n[1];
     c.n2 = M > 2 ? n[M - 1] : 0;
@@ -54,16 +62,26 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
     c.first1 = first[1];
     c.first2 = M > 2 ? first[M - 1] : 0u;
     kern::PixelSums sums = kern::zeroPixelSums();
-    for (int j = 0; j < plan.stageSamples; ++j)
-      kern::addContribution(&sums, kern::takeStageSample(ts, env, b, c, j, uint32_t(seed), uint32_t(seed >> 32),
-                                                         uint32_t(pixel)));
+    double* running = stats_.data() + size_t(pixel) * slots;
+    for (int j = 0; j < plan.stageSamples; ++j) {
+      kern::SampleContribution s =
+          kern::takeStageSample(ts, env, b, c, j, uint32_t(seed), uint32_t(seed >> 32), uint32_t(pixel));
+      kern::addContribution(&sums, s);
+      for (int slot = 0; slot < slots; ++slot)
+        if (s.technique == slot / perTechnique) running[slot] += kern::statValue(int(config_.statsMask), slot % perTechnique, s);
+      if (config_.sampleCapacity > 0) {
+        int i = plan.samplesBefore + j;
+        samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, M)] = float(s.technique);
+        samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, M)] = s.y;
+        for (int l = 0; l < M; ++l) samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, M)] = s.pdfs[l];
+      }
+    }
     double* rgb = result.rgb.data() + size_t(pixel) * 3;
     rgb[0] = sums.r;
     rgb[1] = sums.g;
     rgb[2] = sums.b;
-    double* m = result.moments.data() + size_t(pixel) * M * 2;
     const double moments[6] = {sums.w0, sums.ww0, sums.w1, sums.ww1, sums.w2, sums.ww2};
-    std::copy(moments, moments + 2 * M, m);
+    std::copy(moments, moments + 2 * M, result.moments.data() + size_t(pixel) * M * 2);
   }
   result.kernelSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -5,28 +5,68 @@
 #include <cmath>
 
 #include "Error.h"
+#include "KernelCode.h"
 
 namespace misalloc {
+namespace {
+
+struct MethodName {
+  Method method;
+  const char* name;
+};
+
+constexpr MethodName kMethods[] = {
+    {Method::Envmap, "envmap"}, {Method::Brdf, "brdf"},       {Method::Equal, "equal"},
+    {Method::Heuristic, "heuristic"}, {Method::SigmaSqrtC, "sigma-sqrt-c"}, {Method::Linear, "linear"},
+    {Method::Exact, "exact"},
+};
+
+std::string availableMethods() {
+  std::vector<std::string> names;
+  for (const auto& m : kMethods) names.push_back(m.name);
+  return fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace
 
 Method parseMethod(const std::string& name) {
-  if (name == "envmap") return Method::Envmap;
-  if (name == "brdf") return Method::Brdf;
-  if (name == "equal") return Method::Equal;
-  for (const char* planned : {"heuristic", "sigma-sqrt-c", "linear", "exact", "oracle"})
-    if (name == planned)
-      throw InputError(fmt::format("--method {}: this allocation is not implemented yet (available: envmap, brdf, equal)",
-                                   name));
-  throw InputError(fmt::format("unknown --method '{}' (available: envmap, brdf, equal)", name));
+  for (const auto& m : kMethods)
+    if (name == m.name) return m.method;
+  if (name == "oracle")
+    throw InputError(fmt::format("--method oracle: not implemented yet (available: {})", availableMethods()));
+  throw InputError(fmt::format("unknown --method '{}' (available: {})", name, availableMethods()));
 }
 
 std::string methodName(Method method) {
-  switch (method) {
-    case Method::Envmap: return "envmap";
-    case Method::Brdf: return "brdf";
-    case Method::Equal: return "equal";
-  }
+  for (const auto& m : kMethods)
+    if (method == m.method) return m.name;
   return "?";
 }
+
+std::vector<Method> allMethods() {
+  std::vector<Method> all;
+  for (const auto& m : kMethods) all.push_back(m.method);
+  return all;
+}
+
+bool isAdaptive(Method method) {
+  return method != Method::Envmap && method != Method::Brdf && method != Method::Equal;
+}
+
+Estimator methodEstimator(Method method) {
+  return method == Method::SigmaSqrtC ? Estimator::CountIndependent : Estimator::MultiSample;
+}
+
+unsigned methodStatistics(Method method) {
+  switch (method) {
+    case Method::Heuristic: return MA_STATS_TECHNIQUE;
+    case Method::SigmaSqrtC: return MA_STATS_BALANCE;
+    case Method::Linear: return MA_STATS_LINEAR;
+    default: return 0;
+  }
+}
+
+bool methodStoresSamples(Method method) { return method == Method::Linear || method == Method::Exact; }
 
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel) {
   const int M = scene.techniqueCount();
@@ -43,7 +83,7 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
         counts[2] = spp - counts[1];
       }
       break;
-    case Method::Equal:
+    default:
       for (int k = 0; k < M; ++k) counts[k] = spp / M + (k < spp % M ? 1 : 0);
       break;
   }

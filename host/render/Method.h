@@ -7,19 +7,30 @@
 
 namespace misalloc {
 
-// How a pixel's N samples are split among the techniques.
-enum class Method { Envmap, Brdf, Equal };
+// How a pixel's N samples are split among the techniques. The first three are fixed
+// splits taken in one stage; the others allocate adaptively in batches (render/Adaptive.h).
+enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact };
 
-// Throws InputError for an unknown name, and for the allocations that are not
-// implemented yet (heuristic, sigma-sqrt-c, linear, exact, oracle).
+// Throws InputError for an unknown name, or one that is not implemented (oracle).
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);
+std::vector<Method> allMethods();
+bool isAdaptive(Method method);
 
-// Counts n_k for one pixel, Σ_k n_k = spp. Single-technique methods give the others 0;
-// with the BRDF split into lobes, `brdf` shares its samples by the lobes' albedos.
+// The estimator each method's stages use: σ/√c allocates for the estimator with
+// count-independent weights (002 Sec. 4); everything else for the balance heuristic.
+Estimator methodEstimator(Method method);
+
+// The running sums (kernels/stats.h) and whether the stored samples are needed.
+unsigned methodStatistics(Method method);
+bool methodStoresSamples(Method method);
+
+// Counts n_k for one pixel of a fixed split, Σ_k n_k = spp. Single-technique methods
+// give the others 0; with the BRDF split into lobes, `brdf` shares its samples by
+// the lobes' albedos.
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel);
 
-// One stage of `spp` samples per pixel with the method's counts.
+// One stage of `spp` samples per pixel with a fixed split's counts.
 StagePlan singleStagePlan(const Scene& scene, Method method, int spp);
 
 }  // namespace misalloc

@@ -2,27 +2,49 @@
 #include <cstdint>
 #include <vector>
 
+#include "alloc/LinearAllocation.h"
 #include "render/Method.h"
 #include "render/Sampler.h"
 #include "scene/ExrIO.h"
 
 namespace misalloc {
 
+// The batched schedule of the adaptive methods (000 Algorithm 1, Sec. 5.2).
+struct AdaptiveOptions {
+  double pilotFraction = 0.2;  // of N, split equally among the techniques
+  int stages = 4;              // after the pilot
+  std::vector<double> costs;   // c_k per sample, one per technique
+  ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
+};
+
+// The sizes of the pilot and the following stages, summing to spp. Throws InputError
+// if the budget cannot hold a pilot of two samples per technique plus one stage.
+std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount);
+
 struct Rendering {
   RgbImage image;
   std::vector<double> variance;  // per pixel: estimated variance of the luminance estimate
+  std::vector<double> alpha;     // [pixel·M + k]: the share of the pixel's samples technique k took
+  size_t fallbackPixels = 0;     // pixels where an allocation rule fell back (alloc/Allocation.h)
+  size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
+  int stageCount = 1;
   double kernelSeconds = 0;      // device time of the sampling kernels (profiling events)
+  double allocationSeconds = 0;  // reading statistics back and allocating
   double hostSeconds = 0;        // everything else: planning, transfers, reductions
   double wallSeconds = 0;
 };
 
-// Renders every pixel with `spp` samples split by `method`, in one stage.
-Rendering render(StageSampler& sampler, const Scene& scene, Method method, Estimator estimator, int spp,
-                 uint64_t seed);
+// Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods
+// in a pilot and `stages` batches. The sampler must keep what the method needs
+// (samplerConfigFor).
+Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
+
+SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp);
 
 // Estimated variance of a pixel's stage estimate from the per-technique moments of
-// w = Y/p_α. Multi-sample: Σ_k n_k s_k² / N² (002 eq. 21 with estimated σ_k);
-// one-sample: s² / N over all samples (002 Table 2).
+// its luminance values w. Balance heuristic, multi-sample: Σ_k n_k s_k² / N² (002 eq. 21
+// with estimated σ_k); one-sample: s² / N over all samples (002 Table 2);
+// count-independent weights: Σ_k s_k² / n_k (002 eq. 28).
 double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator);
 
 }  // namespace misalloc

@@ -6,6 +6,15 @@
 
 namespace misalloc {
 
+std::string estimatorName(Estimator estimator) {
+  switch (estimator) {
+    case Estimator::MultiSample: return "multi-sample balance heuristic";
+    case Estimator::OneSample: return "one-sample balance heuristic";
+    case Estimator::CountIndependent: return "count-independent weights (002 eq. 26)";
+  }
+  return "?";
+}
+
 nlohmann::json sceneJson(const Scene& scene) {
   const SceneOptions& o = scene.options;
   return {{"envmap", o.envmap},
@@ -21,20 +30,47 @@ nlohmann::json sceneJson(const Scene& scene) {
 
 nlohmann::json renderReport(const RenderRun& run) {
   const Rendering& r = run.rendering;
+  const int pixels = run.scene.pixelCount(), M = run.scene.techniqueCount();
   double meanVariance = 0;
   for (double v : r.variance) meanVariance += v;
-  meanVariance /= double(r.variance.size());
+  meanVariance /= pixels;
+  nlohmann::json meanAlpha;
+  auto names = run.scene.techniqueNames();
+  for (int k = 0; k < M; ++k) {
+    double sum = 0;
+    for (int p = 0; p < pixels; ++p) sum += r.alpha[size_t(p) * M + k];
+    meanAlpha[names[k]] = sum / pixels;
+  }
   nlohmann::json report = {
       {"scene", sceneJson(run.scene)},
       {"method", methodName(run.method)},
-      {"estimator", run.estimator == Estimator::OneSample ? "one-sample" : "multi-sample"},
+      {"estimator", estimatorName(run.estimator)},
       {"spp", run.spp},
       {"seed", run.seed},
       {"device", run.device},
-      {"time_s", {{"wall", r.wallSeconds}, {"kernel", r.kernelSeconds}, {"host", r.hostSeconds}}},
-      {"samples_per_second", double(run.scene.pixelCount()) * run.spp / r.kernelSeconds},
+      {"time_s",
+       {{"wall", r.wallSeconds}, {"kernel", r.kernelSeconds}, {"allocation", r.allocationSeconds},
+        {"host", r.hostSeconds}}},
+      {"samples_per_second", double(pixels) * run.spp / r.kernelSeconds},
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
+      {"mean_alpha", meanAlpha},
   };
+  if (isAdaptive(run.method)) {
+    nlohmann::json costs;
+    for (int k = 0; k < M; ++k) costs[names[k]] = run.adaptive.costs[k];
+    report["allocation"] = {
+        {"stages", r.stageCount},
+        {"pilot_fraction", run.adaptive.pilotFraction},
+        {"costs_s_per_sample", costs},
+        {"costs_source", run.costSource},
+        {"fallback_pixel_fraction", double(r.fallbackPixels) / pixels},
+        {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
+    };
+    if (run.method == Method::Linear)
+      report["allocation"]["zero_weight_rule"] =
+          run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance ? "min sample variance (003 eq. 19)"
+                                                                       : "drop most negative (003 Sec. 5.1)";
+  }
   if (run.reference) {
     report["reference"] = {{"source", run.reference->source}, {"path", run.reference->path}};
     report["rmse_x1000"] = 1000 * rmse(r.image, run.reference->image);

@@ -13,6 +13,8 @@ struct RenderRun {
   const Scene& scene;
   Method method;
   Estimator estimator;
+  const AdaptiveOptions& adaptive;
+  std::string costSource;  // "measured" or "--cost"
   int spp;
   uint64_t seed;
   std::string device;
@@ -21,9 +23,12 @@ struct RenderRun {
 };
 
 // The JSON report of one render: scene, method, spp, device, wall time split into
-// kernel and host time, and the errors against the reference when there is one.
+// kernel, allocation and host time, the allocation's schedule, costs, mean α and
+// defensive-rule counts, and the errors against the reference when there is one.
 nlohmann::json renderReport(const RenderRun& run);
 
 nlohmann::json sceneJson(const Scene& scene);
+
+std::string estimatorName(Estimator estimator);
 
 }  // namespace misalloc

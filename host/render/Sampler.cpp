@@ -2,19 +2,18 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
-
 #include "Error.h"
+#include "KernelCode.h"
 
 namespace misalloc {
 namespace {
 
 template <typename T>
-cl::Buffer upload(const Device& d, const std::vector<T>& data) {
-  return cl::Buffer(d.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T),
-                    const_cast<T*>(data.data()));
+cl::Buffer upload(const Device& d, const std::vector<T>& data, cl_mem_flags flags = CL_MEM_READ_ONLY) {
+  return cl::Buffer(d.context, flags | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(T), const_cast<T*>(data.data()));
 }
 
+// Sums are double where the device has it (ma_acc in kernels/common.h), else float.
 template <typename Acc>
 std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t count) {
   std::vector<Acc> raw(count);
@@ -24,43 +23,88 @@ std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t c
 
 }  // namespace
 
-std::string sampleKernelOptions(const Scene& scene, Estimator estimator, int localSize) {
+StageSampler::StageSampler(const Scene& scene, const SamplerConfig& config) : scene_(scene), config_(config) {
+  if (config.sampleCapacity < 0) throw std::invalid_argument("negative sample capacity");
+  if (config.estimator == Estimator::OneSample && (config.statsMask != 0 || config.sampleCapacity > 0))
+    throw std::invalid_argument("the allocations' statistics are kept for the multi-sample estimators only");
+}
+
+int StageSampler::statSlots() const {
+  return scene_.techniqueCount() * MA_STATS_PER_TECHNIQUE(int(config_.statsMask), scene_.techniqueCount());
+}
+
+size_t StageSampler::storedSampleCount() const {
+  size_t paddedPixels = (size_t(scene_.pixelCount()) + 15) / 16 * 16;
+  return paddedPixels * size_t(config_.sampleCapacity) * size_t(scene_.techniqueCount() + 2);
+}
+
+std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
+  const int M = scene.techniqueCount();
+  std::vector<float> samples((size_t(scene.pixelCount()) + 15) / 16 * 16 * size_t(capacity) * size_t(M + 2), 1.0f);
+  for (size_t record = 0; record < samples.size() / 16; ++record) {
+    int q = int(record % size_t(M + 2));
+    if (q < 2) std::fill_n(samples.begin() + record * 16, 16, 0.0f);
+  }
+  return samples;
+}
+
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize) {
   const EnvmapTables& t = scene.tables;
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
-      "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_ONE_SAMPLE={} -DMA_LOCAL_SIZE={}",
+      "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_STATS={} "
+      "-DMA_STORE_SAMPLES={} -DMA_LOCAL_SIZE={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
-      scene.envmap.coskExponent, estimator == Estimator::OneSample ? 1 : 0, localSize);
+      scene.envmap.coskExponent, config.estimator == Estimator::OneSample ? 1 : 0,
+      config.estimator == Estimator::CountIndependent ? 1 : 0, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
+      localSize);
 }
 
-Sampler::Sampler(const Device& device, const Scene& scene, Estimator estimator, int localSize)
-    : device_(device), scene_(scene), localSize_(localSize) {
+Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize)
+    : StageSampler(scene, config), device_(device), localSize_(localSize) {
   if (localSize < 1) throw InputError("--local-size must be at least 1");
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
-  cl::Program program = buildProgram(device, "sample.cl", sampleKernelOptions(scene, estimator, localSize));
+  cl::Program program = buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize));
   kernel_ = cl::Kernel(program, "sampleStage");
   const EnvmapTables& t = scene.tables;
   texels_ = upload(device, t.texels);
-  samplerTable_ = upload(device, t.samplerTable);
-  aliasIndex_ = upload(device, t.aliasIndex);
+  cdfTable_ = upload(device, t.cdfTable);
+  aliasTable_ = upload(device, t.aliasTable);
   std::vector<float> params;
   params.reserve(scene.grid.pixels.size() * 4);
   for (const auto& p : scene.grid.pixels) params.insert(params.end(), {p.rhoD, p.rhoS, p.n, 0.0f});
   brdfParams_ = upload(device, params);
+  // OpenCL buffers cannot be empty: a method without running sums or stored samples
+  // gets a one-element placeholder.
+  const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
+  const size_t slots = std::max<size_t>(1, size_t(scene.pixelCount()) * statSlots());
+  stats_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, slots * accSize);
+  device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
+  samples_ = config.sampleCapacity > 0 ? upload(device, emptyStoredSamples(scene, config.sampleCapacity), CL_MEM_READ_WRITE)
+                                       : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
+  // with a stage of no samples, not inside the first timed stage.
+  StagePlan empty;
+  empty.techniqueCount = scene.techniqueCount();
+  empty.counts.assign(size_t(scene.pixelCount()) * empty.techniqueCount, 0);
+  empty.firstIndex.assign(empty.counts.size(), 0u);
+  run(empty, 0);
 }
 
 StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
   if (plan.techniqueCount != M || plan.counts.size() != size_t(pixels) * M)
     throw std::logic_error("stage plan does not match the scene");
+  if (config_.sampleCapacity > 0 && plan.samplesBefore + plan.stageSamples > config_.sampleCapacity)
+    throw std::logic_error("stage overflows the stored-samples buffer");
   const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
   cl::Buffer counts = upload(device_, plan.counts), firstIndex = upload(device_, plan.firstIndex);
   cl::Buffer rgb(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * 3 * accSize);
   cl::Buffer moments(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * M * 2 * accSize);
   int a = 0;
   kernel_.setArg(a++, texels_);
-  kernel_.setArg(a++, samplerTable_);
-  kernel_.setArg(a++, aliasIndex_);
+  kernel_.setArg(a++, cdfTable_);
+  kernel_.setArg(a++, aliasTable_);
   kernel_.setArg(a++, cl_int(scene_.tables.width));
   kernel_.setArg(a++, cl_int(scene_.tables.height));
   kernel_.setArg(a++, brdfParams_);
@@ -73,6 +117,10 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   kernel_.setArg(a++, cl_int(pixels));
   kernel_.setArg(a++, rgb);
   kernel_.setArg(a++, moments);
+  kernel_.setArg(a++, stats_);
+  kernel_.setArg(a++, samples_);
+  kernel_.setArg(a++, cl_int(plan.samplesBefore));
+  kernel_.setArg(a++, cl_int(config_.sampleCapacity));
   size_t global = (size_t(pixels) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr,
@@ -82,14 +130,24 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   result.kernelSeconds =
       double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
       1e-9;
-  if (doubleSums_) {
-    result.rgb = readSums<double>(device_, rgb, size_t(pixels) * 3);
-    result.moments = readSums<double>(device_, moments, size_t(pixels) * M * 2);
-  } else {
-    result.rgb = readSums<float>(device_, rgb, size_t(pixels) * 3);
-    result.moments = readSums<float>(device_, moments, size_t(pixels) * M * 2);
-  }
+  auto read = [&](const cl::Buffer& b, size_t n) {
+    return doubleSums_ ? readSums<double>(device_, b, n) : readSums<float>(device_, b, n);
+  };
+  result.rgb = read(rgb, size_t(pixels) * 3);
+  result.moments = read(moments, size_t(pixels) * M * 2);
   return result;
+}
+
+std::vector<double> Sampler::statistics() {
+  const size_t n = size_t(scene_.pixelCount()) * statSlots();
+  if (n == 0) return {};
+  return doubleSums_ ? readSums<double>(device_, stats_, n) : readSums<float>(device_, stats_, n);
+}
+
+std::vector<float> Sampler::storedSamples() {
+  std::vector<float> out(storedSampleCount());
+  if (!out.empty()) device_.queue.enqueueReadBuffer(samples_, CL_TRUE, 0, out.size() * sizeof(float), out.data());
+  return out;
 }
 
 }  // namespace misalloc

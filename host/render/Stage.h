@@ -4,7 +4,11 @@
 
 namespace misalloc {
 
-enum class Estimator { MultiSample, OneSample };
+enum class Estimator {
+  MultiSample,       // balance heuristic with deterministic counts (000 eq. 4.1)
+  OneSample,         // balance heuristic, technique drawn with probabilities α
+  CountIndependent,  // weights p_k/Σ_l p_l whatever the counts (002 eq. 26)
+};
 
 // What one sampling stage takes per pixel: counts n_k (multi-sample; for the
 // one-sample estimator they give the selection probabilities α_k = n_k/N) and the
@@ -13,16 +17,24 @@ enum class Estimator { MultiSample, OneSample };
 struct StagePlan {
   int techniqueCount = 0;
   int stageSamples = 0;              // N: the same for every pixel
+  int samplesBefore = 0;             // samples each pixel took in earlier stages
   std::vector<int32_t> counts;       // [pixel·M + k], Σ_k = N
   std::vector<uint32_t> firstIndex;  // [pixel·M + k]
 };
 
 // Per pixel: this stage's unbiased RGB estimate and, per technique, Σ w and Σ w² of
-// the luminance sample values w = Y(f)/p_α (kernels/pixel.h).
+// the luminance sample values w (kernels/pixel.h).
 struct StageResult {
   std::vector<double> rgb;      // [pixel·3 + c]
   std::vector<double> moments;  // [(pixel·M + k)·2 + {0, 1}]
   double kernelSeconds = 0;
+};
+
+// What a sampler keeps beyond the stage estimates, for the allocations.
+struct SamplerConfig {
+  Estimator estimator = Estimator::MultiSample;
+  unsigned statsMask = 0;  // running sums kept across stages (kernels/stats.h)
+  int sampleCapacity = 0;  // > 0: every sample is stored, up to this many per pixel
 };
 
 }  // namespace misalloc

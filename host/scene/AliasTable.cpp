@@ -1,5 +1,6 @@
 #include "scene/AliasTable.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -15,7 +16,8 @@ AliasTable buildAliasTable(std::vector<double> weights) {
     if (!(w >= 0) || !std::isfinite(w)) throw std::invalid_argument("alias table weights must be finite and >= 0");
     total += w;
   }
-  if (!(total > 0) || !std::isfinite(total)) throw std::invalid_argument("alias table weights must have a finite, positive sum");
+  if (!(total > 0) || !std::isfinite(total))
+    throw std::invalid_argument("alias table weights must have a finite, positive sum");
 
   // q_i = N p_i: bucket i keeps q_i of its unit of mass and lends the rest to its alias.
   // w / total ≤ 1 cannot overflow, whatever the weights' scale.
@@ -28,12 +30,8 @@ AliasTable buildAliasTable(std::vector<double> weights) {
   // from the at most one positive pairing per large bucket, far below a unit. So
   // every zero gets probability 0 and a positive alias instead of being left over.
   std::vector<uint32_t> under, over;
-  for (uint32_t i = 0; i < n; ++i) {
-    if (q[i] >= 1) over.push_back(i);
-    else if (q[i] > 0) under.push_back(i);
-  }
-  for (uint32_t i = 0; i < n; ++i)
-    if (q[i] == 0) under.push_back(i);
+  for (uint32_t i = 0; i < n; ++i) (q[i] < 1 ? under : over).push_back(i);
+  std::partition(under.begin(), under.end(), [&q](uint32_t i) { return q[i] > 0; });
 
   AliasTable table{std::vector<float>(n), std::vector<uint32_t>(n)};
   while (!under.empty() && !over.empty()) {
@@ -49,8 +47,12 @@ AliasTable buildAliasTable(std::vector<double> weights) {
     }
   }
   // What is left has q = 1 up to rounding: accept always.
-  for (uint32_t i : under) table.probability[i] = 1, table.alias[i] = i;
-  for (uint32_t i : over) table.probability[i] = 1, table.alias[i] = i;
+  for (const auto* rest : {&under, &over}) {
+    for (uint32_t i : *rest) {
+      table.probability[i] = 1;
+      table.alias[i] = i;
+    }
+  }
   return table;
 }
 

@@ -202,8 +202,8 @@ Envmap sunMap(double theta, double phi, double radius, double ratio, int width) 
   return map;
 }
 
-Envmap proceduralMap(const std::string& name, const std::string& arguments, bool hasArguments,
-                     const std::string& spec, int width) {
+Envmap proceduralMap(const std::string& name, const std::string& arguments, bool hasArguments, const std::string& spec,
+                     int width) {
   if (width < 2 || width > kMaxProceduralWidth)
     throw InputError(fmt::format("procedural envmap width {} is not in [2, {}]", width, kMaxProceduralWidth));
   if (name == "constant") {

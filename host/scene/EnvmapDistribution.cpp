@@ -6,6 +6,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 #include "Error.h"
@@ -18,16 +19,16 @@ constexpr double kPi = 3.14159265358979323846;
 
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
 
-void requireKernelAddressable(const Envmap& envmap) {
+void requireValidSize(const Envmap& envmap) {
   const RgbImage& image = envmap.image;
+  // kernels/envmap.h indexes the texels' floats as int 4·t.
+  if (int64_t(image.width) * image.height * 4 > INT_MAX)
+    throw InputError(fmt::format("envmap '{}' has {}×{} texels, too many for the kernels' 32-bit indices (at most {})",
+                                 envmap.description, image.width, image.height, INT_MAX / 4));
   if (image.width < 1 || image.height < 1 ||
       image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(fmt::format("envmap '{}' has {}×{} texels and {} floats", envmap.description,
                                             image.width, image.height, image.rgb.size()));
-  // kernels/envmap.h indexes the texels as int 4·t.
-  if (int64_t(image.width) * image.height * 4 > INT_MAX)
-    throw InputError(fmt::format("envmap '{}' has {}×{} texels, too many for the kernels' 32-bit indices "
-                                 "(at most {} texels)", envmap.description, image.width, image.height, INT_MAX / 4));
 }
 
 // Luminance × sin θ at the texel centre: p(ω) = P W H / (2π² sin θ) inside a texel,
@@ -85,6 +86,34 @@ std::vector<float> cdfTables(const std::vector<double>& weights, int width, int 
   return table;
 }
 
+// uniformFloat (kernels/rng.h) draws k / 2^24, k ∈ [0, 2^24); searchCdf picks i for
+// cdf[i] ≤ u < cdf[i+1], so i is drawn for ceil(2^24 cdf[i+1]) − ceil(2^24 cdf[i]) of them.
+double drawnShare(const float* cdf, int i) {
+  constexpr double grid = 16777216.0;
+  return (std::ceil(double(cdf[i + 1]) * grid) - std::ceil(double(cdf[i]) * grid)) / grid;
+}
+
+// The probability of each texel under the CDF sampler, exactly as drawn.
+void storeDrawnProbabilities(const std::vector<float>& cdf, int width, int height, std::vector<float>& texels) {
+  const float* marginal = cdf.data();
+  for (int row = 0; row < height; ++row) {
+    double rowShare = drawnShare(marginal, row);
+    const float* conditional = marginal + (height + 1) + std::size_t(row) * std::size_t(width + 1);
+    for (int col = 0; col < width; ++col)
+      texels[4 * (std::size_t(row) * width + col) + 3] = float(rowShare * drawnShare(conditional, col));
+  }
+}
+
+// Acceptance probability and alias of each bucket, interleaved.
+std::vector<uint32_t> interleave(const AliasTable& alias) {
+  std::vector<uint32_t> table(2 * alias.probability.size());
+  for (std::size_t b = 0; b < alias.probability.size(); ++b) {
+    std::memcpy(&table[2 * b], &alias.probability[b], sizeof(float));
+    table[2 * b + 1] = alias.alias[b];
+  }
+  return table;
+}
+
 // ceil(log2(n)), 0 for n = 1: searchCdf halves its range rounding up.
 int binarySearchSteps(int n) {
   int steps = 0;
@@ -95,7 +124,7 @@ int binarySearchSteps(int n) {
 }  // namespace
 
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler) {
-  requireKernelAddressable(envmap);
+  requireValidSize(envmap);
   const RgbImage& image = envmap.image;
   EnvmapTables tables;
   tables.width = image.width;
@@ -119,14 +148,14 @@ EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler) {
 
   tables.useCdf = sampler == EnvmapSampler::Cdf;
   if (tables.useCdf) {
-    tables.samplerTable = cdfTables(weights, image.width, image.height);
-    tables.aliasIndex = {0};
+    tables.cdfTable = cdfTables(weights, image.width, image.height);
+    tables.aliasTable = {0};
     tables.cdfStepsRow = binarySearchSteps(image.height);
     tables.cdfStepsCol = binarySearchSteps(image.width);
+    storeDrawnProbabilities(tables.cdfTable, image.width, image.height, tables.texels);
   } else {
-    AliasTable alias = buildAliasTable(std::move(weights));
-    tables.samplerTable = std::move(alias.probability);
-    tables.aliasIndex = std::move(alias.alias);
+    tables.cdfTable = {0};
+    tables.aliasTable = interleave(buildAliasTable(std::move(weights)));
   }
   return tables;
 }

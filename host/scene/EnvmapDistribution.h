@@ -14,12 +14,15 @@ enum class EnvmapSampler { Alias, Cdf };
 // The buffers behind kernels/envmap.h's EnvmapView (never empty: OpenCL buffers can't be).
 struct EnvmapTables {
   int width = 0, height = 0;
-  std::vector<float> texels;  // 4 per texel: R, G, B, probability of the texel
-  // Alias: the acceptance probability of each texel's bucket (W·H).
-  // CDF: the marginal CDF over rows (H + 1 values, [0] = 0, [H] = 1), then for each
-  // row its conditional CDF over columns (W + 1 values, [0] = 0, [W] = 1).
-  std::vector<float> samplerTable;
-  std::vector<uint32_t> aliasIndex;  // alias: the alias of each texel; CDF: one unused 0
+  // 4 per texel: R, G, B, and the probability that the sampler draws the texel.
+  std::vector<float> texels;
+  // CDF sampler: the marginal CDF over rows (H + 1 values, [0] = 0, [H] = 1), then for
+  // each row its conditional CDF over columns (W + 1 values, [0] = 0, [W] = 1).
+  // Alias sampler: one unused 0.
+  std::vector<float> cdfTable;
+  // Alias sampler: per bucket, the bits of its float acceptance probability and its
+  // alias, side by side so that one cache line serves a draw. CDF sampler: one unused 0.
+  std::vector<uint32_t> aliasTable;
   bool useCdf = false;
   int cdfStepsRow = 0, cdfStepsCol = 0;  // ceil(log2(H)), ceil(log2(W)): searchCdf's steps
   // The map is black, so the texels are drawn ∝ sin θ instead: uniform over the
@@ -30,7 +33,10 @@ struct EnvmapTables {
 // Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B times sin θ at the
 // texel's centre, so that the solid-angle pdf is ∝ luminance. Probabilities and
 // prefix sums are computed in double and stored as float; a texel of weight 0 is never
-// drawn by either sampler. The texels must be finite and ≥ 0, as readExr and
+// drawn by either sampler. The alias sampler stores the weights' probabilities. The
+// CDF sampler stores the probabilities its float CDFs realise with the kernel's 24-bit
+// uniforms: they differ from the weights' by up to ~2^-24 (W+H) in total, and an
+// estimate that divides by the stored pdf stays exactly unbiased. The texels must be finite and ≥ 0, as readExr and
 // makeEnvmap make them (else std::invalid_argument). Throws InputError, naming the
 // map, if it has too many texels for the kernels' 32-bit int indexing.
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler);

@@ -40,7 +40,8 @@ void requireOpenExrFile(const std::string& path) {
 
 std::string channelNames(const Imf::ChannelList& channels) {
   std::string names;
-  for (auto c = channels.begin(); c != channels.end(); ++c) names += (names.empty() ? "" : ", ") + std::string(c.name());
+  for (auto c = channels.begin(); c != channels.end(); ++c)
+    names += (names.empty() ? "" : ", ") + std::string(c.name());
   return names.empty() ? "none" : names;
 }
 
@@ -70,7 +71,7 @@ RgbImage readRgbPixels(const std::string& path) {
   Imf::FrameBuffer frame;
   for (int c = 0; c < 3; ++c)
     frame.insert(std::string(1, kRgbNames[c]), Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window, pixelBytes,
-                                                                 pixelBytes * std::size_t(image.width)));
+                                                                pixelBytes * std::size_t(image.width)));
   file.setFrameBuffer(frame);
   file.readPixels(window.min.y, window.max.y);
   return image;
@@ -157,14 +158,14 @@ RgbImage readExr(const std::string& path, ReadWarnings* warnings) {
 
 void writeExr(const std::string& path, const RgbImage& image) {
   if (image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
-    throw std::invalid_argument(fmt::format("RgbImage {}×{} holds {} floats, not 3 per pixel", image.width,
-                                            image.height, image.rgb.size()));
+    throw std::invalid_argument(
+        fmt::format("RgbImage {}×{} holds {} floats, not 3 per pixel", image.width, image.height, image.rgb.size()));
   Imf::Header header = floatHeader(image.width, image.height, {"R", "G", "B"});
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
   for (int c = 0; c < 3; ++c)
-    frame.insert(std::string(1, kRgbNames[c]),
-                 Imf::Slice(Imf::FLOAT, (char*)(image.rgb.data() + c), pixelBytes, pixelBytes * std::size_t(image.width)));
+    frame.insert(std::string(1, kRgbNames[c]), Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, header.dataWindow(),
+                                                                pixelBytes, pixelBytes * std::size_t(image.width)));
   writeAtomically(path, header, frame);
 }
 
@@ -178,9 +179,9 @@ void writeExrChannels(const std::string& path, int width, int height, const std:
   Imf::FrameBuffer frame;
   for (std::size_t k = 0; k < names.size(); ++k) {
     if (planes[k].size() != std::size_t(width) * std::size_t(height))
-      throw std::invalid_argument(fmt::format("plane '{}' holds {} values, not {}×{}", names[k], planes[k].size(),
-                                              width, height));
-    frame.insert(names[k], Imf::Slice(Imf::FLOAT, (char*)planes[k].data(), sizeof(float), sizeof(float) * std::size_t(width)));
+      throw std::invalid_argument(
+          fmt::format("plane '{}' holds {} values, not {}×{}", names[k], planes[k].size(), width, height));
+    frame.insert(names[k], Imf::Slice::Make(Imf::FLOAT, planes[k].data(), header.dataWindow()));
   }
   writeAtomically(path, header, frame);
 }

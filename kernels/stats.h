@@ -1,0 +1,51 @@
+// The running per-pixel sums that the allocations estimate their statistics from
+// (host/alloc/PixelStats.h, which decodes them). A stage adds each sample to the sums
+// of the technique that drew it; MA_STATS chooses which sums a method keeps, so that
+// each method stores only what it reads.
+#ifndef MA_STATS_H
+#define MA_STATS_H
+#include "pixel.h"
+
+#define MA_STATS_TECHNIQUE 1  // Σ f/p_k and Σ (f/p_k)²: V_k of 000 eq. 4.18 (heuristic)
+#define MA_STATS_BALANCE 2    // Σ f/Σ_l p_l and its square: σ_k of 002 eq. 27–28 (σ/√c)
+#define MA_STATS_LINEAR 4     // F_k = Σ f and P_ik = Σ p_i: 003 eq. 18 (linear)
+
+// Per technique: the count, then the sums that `mask` selects, in the order above. A
+// macro: kernels size local arrays with it.
+#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                      \
+  (1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
+   (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
+
+// What sample s adds to slot `slot` of the sums of the technique that drew it. Squares
+// are taken in ma_acc: f/p can be near the top of the float range.
+MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
+  float pt = s.technique == 0 ? s.pdfs[0] : (s.technique == 1 ? s.pdfs[1] : s.pdfs[2]);
+  ma_acc w = pt > 0.0f ? (ma_acc)s.y / (ma_acc)pt : 0;
+  float pSum = s.pdfs[0] + s.pdfs[1] + s.pdfs[2];
+  ma_acc balance = pSum > 0.0f ? (ma_acc)s.y / (ma_acc)pSum : 0;
+  int i = slot - 1;
+  ma_acc value = slot == 0 ? (ma_acc)1 : (ma_acc)0;
+  if (mask & MA_STATS_TECHNIQUE) {
+    value = i == 0 ? w : (i == 1 ? w * w : value);
+    i -= 2;
+  }
+  if (mask & MA_STATS_BALANCE) {
+    value = i == 0 ? balance : (i == 1 ? balance * balance : value);
+    i -= 2;
+  }
+  if (mask & MA_STATS_LINEAR) {
+    value = i == 0 ? (ma_acc)s.y : value;
+    value = i == 1 ? (ma_acc)s.pdfs[0] : (i == 2 ? (ma_acc)s.pdfs[1] : (i == 3 ? (ma_acc)s.pdfs[2] : value));
+  }
+  return value;
+}
+
+// Stored samples for the allocations that need every sample (exact, linear with
+// 003 eq. 19), blocked by 16 pixels for float16 loads (kernels/gridsearch.cl):
+// value q of the pixel's sample i is at ((block·capacity + i)(M + 2) + q)·16 + lane, with
+// q = 0 the technique, 1 the luminance f, 2 + l the pdf p_l.
+MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int techniqueCount) {
+  return (((pixel / 16) * capacity + i) * (techniqueCount + 2) + q) * 16 + pixel % 16;
+}
+
+#endif

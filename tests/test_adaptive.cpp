@@ -1,0 +1,93 @@
+// The batched adaptive methods (render/Render.h): every pixel spends exactly its budget,
+// the schedule is what the options say, and the combined estimate is unbiased although
+// each stage's counts depend on the samples before it.
+#include <catch2/catch.hpp>
+#include <fmt/format.h>
+
+#include <cstring>
+
+#include "Error.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "render/Render.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed) {
+  AdaptiveOptions options;
+  options.costs.assign(scene.techniqueCount(), 1.0);
+  Sampler sampler(testDevice(), scene, samplerConfigFor(method, Estimator::MultiSample, spp));
+  return render(sampler, method, options, spp, seed);
+}
+
+MeanAndError imageMean(const RgbImage& image) {
+  return pixelMean(std::vector<double>(image.rgb.begin(), image.rgb.end()));
+}
+
+}  // namespace
+
+TEST_CASE("stage sizes follow the pilot share and sum to the budget", "[adaptive]") {
+  CHECK(stageSizes(0.2, 4, 200, 2) == std::vector<int>{40, 40, 40, 40, 40});
+  CHECK(stageSizes(0.2, 4, 103, 2) == std::vector<int>{21, 21, 21, 20, 20});
+  CHECK(stageSizes(0.1, 2, 20, 3) == std::vector<int>{6, 7, 7});  // at least 2 per technique
+  CHECK_THROWS_AS(stageSizes(0.2, 4, 6, 2), InputError);          // no room after the pilot
+  CHECK_THROWS_AS(stageSizes(0.0, 4, 200, 2), InputError);
+  CHECK_THROWS_AS(stageSizes(0.2, 0, 200, 2), InputError);
+}
+
+TEST_CASE("adaptive methods spend exactly the budget of every pixel", "[adaptive]") {
+  Scene scene = smallScene("forest_slope", "seed000", 24, 16, true);
+  for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
+    Rendering r = renderWith(scene, m, 50, 3);
+    const int M = scene.techniqueCount();
+    size_t wrong = 0;
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      double sum = 0;
+      for (int k = 0; k < M; ++k) {
+        double a = r.alpha[size_t(p) * M + k];
+        wrong += a < 0 || a > 1;
+        sum += a;
+      }
+      wrong += std::abs(sum - 1) > 1e-12;
+    }
+    INFO(methodName(m));
+    CHECK(wrong == 0);
+    CHECK(r.stageCount == 5);
+  }
+}
+
+TEST_CASE("adaptive estimates are unbiased against 000 eq. 6.17", "[adaptive][unbiased]") {
+  // Each pixel of a uniform grid runs its own adaptive schedule on its own samples, so
+  // the pixel estimates are independent and the pixel mean has a known standard error.
+  struct Case {
+    double rhoD, n, K;
+  };
+  const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
+  uint64_t seed = 500;
+  for (const Case& c : cases) {
+    const double expected = 2 * c.rhoD / (c.K + 2) + (1 - c.rhoD) * (c.n + 2) / (c.n + c.K + 2);  // 000 eq. 6.17
+    for (bool split : {false, true}) {
+      Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n),
+                               32, 32, split);
+      for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
+        MeanAndError r = imageMean(renderWith(scene, m, 60, ++seed).image);
+        double z = (r.mean - expected) / std::max(r.standardError, 1e-6 * expected);
+        INFO(fmt::format("rhoD {} n {} K {} split {} {}: mean {} expected {} z {}", c.rhoD, c.n, c.K, split,
+                         methodName(m), r.mean, expected, z));
+        CHECK(std::abs(z) < 4.0);
+      }
+    }
+  }
+}
+
+TEST_CASE("adaptive renders are bit-identical for the same seed", "[adaptive][determinism]") {
+  Scene scene = smallScene("rooitou_park", "seed000", 24, 16);
+  for (Method m : {Method::Heuristic, Method::Linear}) {
+    Rendering a = renderWith(scene, m, 40, 11), b = renderWith(scene, m, 40, 11);
+    CHECK(std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)) == 0);
+    CHECK(a.alpha == b.alpha);
+  }
+}
