@@ -90,17 +90,22 @@ int main(int argc, char** argv) {
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     auto value = [&](const char* flag) { return std::strcmp(argv[i], flag) == 0 && i + 1 < argc; };
-    if (value("--device")) config.device = argv[++i];
-    else if (value("--size")) config.size = std::stoi(argv[++i]);
-    else if (value("--spp")) config.spp = std::stoi(argv[++i]);
-    else rest.push_back(argv[i]);
+    if (value("--device"))
+      config.device = argv[++i];
+    else if (value("--size"))
+      config.size = std::stoi(argv[++i]);
+    else if (value("--spp"))
+      config.spp = std::stoi(argv[++i]);
+    else
+      rest.push_back(argv[i]);
   }
   int restCount = int(rest.size());
   benchmark::Initialize(&restCount, rest.data());
   for (const Variant& v : kVariants) {
     for (const char* impl : {"opencl", "openmp"}) {
       auto fn = std::string(impl) == "opencl" ? benchOpenCl : benchOpenMp;
-      benchmark::RegisterBenchmark(fmt::format("{}/{}", impl, v.name).c_str(), [fn, &v](benchmark::State& s) { fn(s, v); })
+      benchmark::RegisterBenchmark(fmt::format("{}/{}", impl, v.name).c_str(),
+                                   [fn, &v](benchmark::State& s) { fn(s, v); })
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime()
           ->MinTime(0.5)

@@ -34,8 +34,10 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
 void checkWritableOutput(const std::string& path, const std::string& option) {
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
-  if (!fs::is_directory(dir)) throw InputError(fmt::format("{} {}: folder {} does not exist", option, path, dir.string()));
-  if (::access(dir.c_str(), W_OK) != 0) throw InputError(fmt::format("{} {}: folder {} is not writable", option, path, dir.string()));
+  if (!fs::is_directory(dir))
+    throw InputError(fmt::format("{} {}: folder {} does not exist", option, path, dir.string()));
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError(fmt::format("{} {}: folder {} is not writable", option, path, dir.string()));
   if (fs::is_directory(path)) throw InputError(fmt::format("{} {}: is a folder", option, path));
 }
 

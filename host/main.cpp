@@ -1,7 +1,7 @@
 // misalloc: per-pixel MIS sample allocation for envmap × BRDF direct lighting.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
 
@@ -34,7 +34,8 @@ struct SceneArgs {
     app->add_option("--grid", options.grid, "seed000, general:RD0,RD1,N0,N1 or uniform:RD,RS,N")->capture_default_str();
     app->add_option("--size", size, "WxH pixels")->capture_default_str();
     app->add_option("--view", view, "view direction: polar angle THETA[,PHI] in degrees")->capture_default_str();
-    app->add_flag("--split-brdf", options.splitBrdf, "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
+    app->add_flag("--split-brdf", options.splitBrdf,
+                  "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
     app->add_option("--envmap-sampler", sampler, "alias (O(1)) or cdf (two binary searches)")->capture_default_str();
     app->add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
         ->capture_default_str();
@@ -113,8 +114,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   renderCmd->add_option("--out", out, "output EXR")->capture_default_str();
   renderCmd->add_option("--report", reportPath, "output JSON report")->capture_default_str();
-  renderCmd->add_option("--reference", referenceMode,
-                        "auto (analytic, cached, or computed and cached), none, or an EXR path")
+  renderCmd
+      ->add_option("--reference", referenceMode,
+                   "auto (analytic, cached, or computed and cached), none, or an EXR path")
       ->capture_default_str();
   renderCmd->add_option("--reference-spp", referenceSpp, "spp of a sampled reference")->capture_default_str();
   renderCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();

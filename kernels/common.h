@@ -41,8 +41,16 @@ typedef uint32_t ma_uint;
 typedef uint64_t ma_ulong;
 #define MA_UNROLL
 typedef double ma_acc;
-static inline float ma_as_float(ma_uint u) { float f; std::memcpy(&f, &u, 4); return f; }
-static inline ma_uint ma_as_uint(float f) { ma_uint u; std::memcpy(&u, &f, 4); return u; }
+static inline float ma_as_float(ma_uint u) {
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+static inline ma_uint ma_as_uint(float f) {
+  ma_uint u;
+  std::memcpy(&u, &f, 4);
+  return u;
+}
 #endif
 
 #define MA_PI 3.14159265358979323846f

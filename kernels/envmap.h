@@ -11,8 +11,8 @@
 // Row 0 is the zenith: texel (col, row) covers φ ∈ 2π[col, col+1)/W and
 // θ ∈ π[row, row+1)/H, with z up.
 typedef struct {
-  MA_GLOBAL const float* texels;       // per texel: R, G, B, probability of the texel
-  MA_GLOBAL const float* cdfTable;     // CDF: marginal (H+1) then conditionals H×(W+1)
+  MA_GLOBAL const float* texels;        // per texel: R, G, B, probability of the texel
+  MA_GLOBAL const float* cdfTable;      // CDF: marginal (H+1) then conditionals H×(W+1)
   MA_GLOBAL const ma_uint* aliasTable;  // alias: per bucket, acceptance probability bits and alias
   int width, height;
   int useCdf;

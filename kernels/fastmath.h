@@ -20,7 +20,8 @@ MA_FN float fastLog2(float x) {
   e += big;
   float t = (m - 1.0f) / (m + 1.0f);
   float t2 = t * t;
-  float series = ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 1.0f / 9.0f, 1.0f / 7.0f), 1.0f / 5.0f), 1.0f / 3.0f), 1.0f);
+  float series =
+      ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 1.0f / 9.0f, 1.0f / 7.0f), 1.0f / 5.0f), 1.0f / 3.0f), 1.0f);
   return (float)e + 2.0f * MA_LOG2E * t * series;
 }
 
@@ -30,8 +31,16 @@ MA_FN float fastExp2(float y) {
   y = ma_min(ma_max(y, -127.0f), 127.0f);
   float i = ma_floor(y);
   float g = (y - i - 0.5f) * MA_LN2;
-  float p = ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, 1.0f / 5040.0f, 1.0f / 720.0f), 1.0f / 120.0f),
-                                                      1.0f / 24.0f), 1.0f / 6.0f), 0.5f), 1.0f), 1.0f);
+  float p = ma_fma(
+      g,
+      ma_fma(
+          g,
+          ma_fma(g,
+                 ma_fma(g, ma_fma(g, ma_fma(g, ma_fma(g, 1.0f / 5040.0f, 1.0f / 720.0f), 1.0f / 120.0f), 1.0f / 24.0f),
+                        1.0f / 6.0f),
+                 0.5f),
+          1.0f),
+      1.0f);
   p *= 1.41421356237309505f;
   int ei = (int)i + 127;
   float scale = ma_as_float((ma_uint)(ei > 0 ? ei : 0) << 23);
@@ -52,7 +61,9 @@ MA_FN MaSinCos sinCos2Pi(float u) {
   float q = ma_floor(v + 0.5f);
   float r = (v - q) * (0.5f * MA_PI);
   float r2 = r * r;
-  float sr = r * ma_fma(r2, ma_fma(r2, ma_fma(r2, ma_fma(r2, 1.0f / 362880.0f, -1.0f / 5040.0f), 1.0f / 120.0f), -1.0f / 6.0f), 1.0f);
+  float sr =
+      r * ma_fma(r2, ma_fma(r2, ma_fma(r2, ma_fma(r2, 1.0f / 362880.0f, -1.0f / 5040.0f), 1.0f / 120.0f), -1.0f / 6.0f),
+                 1.0f);
   float cr = ma_fma(r2, ma_fma(r2, ma_fma(r2, ma_fma(r2, 1.0f / 40320.0f, -1.0f / 720.0f), 1.0f / 24.0f), -0.5f), 1.0f);
   // Rotate by q quarter turns, with selects rather than branches that vectorise.
   int quadrant = (int)q;
@@ -66,8 +77,17 @@ MA_FN MaSinCos sinCos2Pi(float u) {
 // acos(x) on [-1, 1]: Abramowitz & Stegun 4.4.46, |error| ≤ 2e-8 on [0, 1].
 MA_FN float fastAcos(float x) {
   float a = ma_min(ma_abs(x), 1.0f);
-  float p = ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, -0.0012624911f, 0.0066700901f), -0.0170881256f),
-                                                     0.0308918810f), -0.0501743046f), 0.0889789874f), -0.2145988016f), 1.5707963050f);
+  float p = ma_fma(
+      a,
+      ma_fma(
+          a,
+          ma_fma(
+              a,
+              ma_fma(a, ma_fma(a, ma_fma(a, ma_fma(a, -0.0012624911f, 0.0066700901f), -0.0170881256f), 0.0308918810f),
+                     -0.0501743046f),
+              0.0889789874f),
+          -0.2145988016f),
+      1.5707963050f);
   float r = ma_sqrt(1.0f - a) * p;
   return x < 0.0f ? MA_PI - r : r;
 }
@@ -79,9 +99,19 @@ MA_FN float fastAtan2Positive(float y, float x) {
   float hi = ma_max(ma_max(ax, ay), 1e-30f);
   float t = ma_min(ax, ay) / hi;
   float t2 = t * t;
-  float p = ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 0.0028662257f, -0.0161657367f),
-                                                        0.0429096138f), -0.0752896400f), 0.1065626393f), -0.1420889944f),
-                                     0.1999355085f), -0.3333314528f), 1.0f);
+  float p = ma_fma(
+      t2,
+      ma_fma(t2,
+             ma_fma(t2,
+                    ma_fma(t2,
+                           ma_fma(t2,
+                                  ma_fma(t2, ma_fma(t2, ma_fma(t2, 0.0028662257f, -0.0161657367f), 0.0429096138f),
+                                         -0.0752896400f),
+                                  0.1065626393f),
+                           -0.1420889944f),
+                    0.1999355085f),
+             -0.3333314528f),
+      1.0f);
   float r = t * p;
   r = ay > ax ? 0.5f * MA_PI - r : r;
   r = x < 0.0f ? MA_PI - r : r;

@@ -108,7 +108,17 @@ MA_FN ChunkSums sumChunk(__global const float* block, int taken, float16 scale,
       float16 p = alpha[c][0] * s.pdf[0];
       MA_UNROLL
       for (int k = 1; k < MA_TECHNIQUES; ++k) p = fma((float16)alpha[c][k], s.pdf[k], p);
+#if MA_RECIP_MODE == 1
+      float16 r = as_float16((uint16)0x7EF311C3u - as_uint16(p));
+      r = fma(r, fma(-p, r, 1.0f), r);
+      r = fma(r, fma(-p, r, 1.0f), r);
+      r = fma(r, fma(-p, r, 1.0f), r);
+      float16 g = fs * r;
+#elif MA_RECIP_MODE == 2
+      float16 g = native_divide(fs, p);
+#else
       float16 g = fs / p;
+#endif
       MA_UNROLL
       for (int j = 0; j < MA_TECHNIQUES; ++j) {
         float16 tg = t[j] * g;

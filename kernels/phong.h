@@ -58,7 +58,9 @@ MA_FN MaVec3 directionAbout(MaVec3 axis, float cosAlpha, float u) {
   return lobeToWorld(axis, sinAlpha * phi.c, sinAlpha * phi.s, cosAlpha);
 }
 
-MA_FN MaVec3 sampleDiffuse(float u1, float u2) { return directionAbout(makeVec3(0.0f, 0.0f, 1.0f), ma_sqrt(1.0f - u1), u2); }
+MA_FN MaVec3 sampleDiffuse(float u1, float u2) {
+  return directionAbout(makeVec3(0.0f, 0.0f, 1.0f), ma_sqrt(1.0f - u1), u2);
+}
 
 // cos α = u^(1/(n+1)) inverts the CDF of the cos^n lobe.
 MA_FN MaVec3 sampleSpecular(PhongParams b, MaVec3 mirror, float u1, float u2) {

@@ -9,9 +9,9 @@
 
 typedef struct {
   int techniqueCount, stageSamples, oneSample;
-  int countIndependent;             // 002 eq. 26 instead of the balance heuristic
-  int n0, n1, n2;                   // this stage's counts (one-sample: expected counts)
-  ma_uint first0, first1, first2;   // index of each technique's first sample this stage
+  int countIndependent;            // 002 eq. 26 instead of the balance heuristic
+  int n0, n1, n2;                  // this stage's counts (one-sample: expected counts)
+  ma_uint first0, first1, first2;  // index of each technique's first sample this stage
 } StageCounts;
 
 typedef struct {

@@ -75,9 +75,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
   for (int j = 0; j < stageSamples; ++j) {
-    SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams,
-                                         makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
-                                         seedLo, seedHi, pixel, j);
+    SampleContribution c =
+        sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams, makeVec3(mirrorX, mirrorY, mirrorZ),
+                      counts, firstIndex, stageSamples, seedLo, seedHi, pixel, j);
     ma_acc w = (ma_acc)c.w, ww = w * w;
     sums[SUM_R][lid] += (ma_acc)c.r;
     sums[SUM_G][lid] += (ma_acc)c.g;

@@ -12,7 +12,7 @@
 
 // Per technique: the count, then the sums that `mask` selects, in the order above. A
 // macro: kernels size local arrays with it.
-#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                      \
+#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                 \
   (1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
    (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
 

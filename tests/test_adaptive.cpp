@@ -1,9 +1,9 @@
 // The batched adaptive methods (render/Render.h): every pixel spends exactly its budget,
 // the schedule is what the options say, and the combined estimate is unbiased although
 // each stage's counts depend on the samples before it.
-#include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <catch2/catch.hpp>
 #include <cstring>
 
 #include "Error.h"

@@ -1,7 +1,6 @@
 // The allocation rules of host/alloc on hand-made sums and samples. The numeric
 // oracles are copied from shared/papers/verified_values.json (key named in a comment).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 #include <numeric>

@@ -1,14 +1,14 @@
 // The command line: bad input gets a clear message naming the problem, a non-zero
 // exit, and no output file; a good run writes its image and report.
-#include <catch2/catch.hpp>
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <array>
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include "Error.h"
 #include "TestDevice.h"
@@ -47,9 +47,10 @@ struct TempDir {
 TEST_CASE("render writes an image and a report", "[cli]") {
   TempDir dir;
   auto out = dir.path / "r.exr", report = dir.path / "r.json";
-  auto r = runMisalloc(fmt::format("render --envmap cosk:1 --grid seed000 --size 16x8 --spp 8 --device cpu "
-                                   "--out {} --report {} --cache-dir {}",
-                                   out.string(), report.string(), (dir.path / "cache").string()));
+  auto r =
+      runMisalloc(fmt::format("render --envmap cosk:1 --grid seed000 --size 16x8 --spp 8 --device cpu "
+                              "--out {} --report {} --cache-dir {}",
+                              out.string(), report.string(), (dir.path / "cache").string()));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   REQUIRE(fs::exists(out));
@@ -76,7 +77,12 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--size 0x0", "--size 0x0"},
       {"--size 12", "--size 12"},
       {"--method magic", "unknown --method 'magic'"},
-      {"--method exact", "not implemented yet"},
+      {"--method oracle", "not implemented yet"},
+      {"--method heuristic --spp 5", "smaller than the pilot"},
+      {"--method heuristic --spp 40 --cost 1,0", "costs must be positive"},
+      {"--method heuristic --spp 40 --cost 1", "expected 2 costs"},
+      {"--method heuristic --pilot 1.5", "--pilot 1.5"},
+      {"--method heuristic --estimator one", "multi-sample stages"},
       {"--grid marble", "unknown --grid 'marble'"},
       {"--grid uniform:0.8,0.8,10", "ρd + ρs ≤ 1"},
       {"--device 99", "--device '99'"},
@@ -100,7 +106,8 @@ TEST_CASE("an existing output survives a failed run", "[cli][bad-input]") {
   TempDir dir;
   auto out = dir.path / "r.exr";
   std::ofstream(out) << "previous";
-  auto r = runMisalloc(fmt::format("render --spp 0 --out {} --report {}", out.string(), (dir.path / "r.json").string()));
+  auto r =
+      runMisalloc(fmt::format("render --spp 0 --out {} --report {}", out.string(), (dir.path / "r.json").string()));
   CHECK(r.exitCode != 0);
   std::ifstream in(out);
   std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -110,8 +117,8 @@ TEST_CASE("an existing output survives a failed run", "[cli][bad-input]") {
 TEST_CASE("no OpenCL platform: the message says how to install PoCL", "[cli][bad-input]") {
   // An empty vendor folder hides every ICD from the loader.
   TempDir dir;
-  auto r = runMisalloc("devices", fmt::format("OCL_ICD_VENDORS={} OPENCL_VENDOR_PATH={}", dir.path.string(),
-                                              dir.path.string()));
+  auto r = runMisalloc("devices",
+                       fmt::format("OCL_ICD_VENDORS={} OPENCL_VENDOR_PATH={}", dir.path.string(), dir.path.string()));
   INFO(r.output);
   CHECK(r.exitCode != 0);
   CHECK(r.output.find("pocl-opencl-icd") != std::string::npos);

@@ -2,7 +2,6 @@
 // shared/papers/verified_values.json, copied here with the JSON key they come from.
 // Tolerances match the digits the paper prints, or are tighter.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <sstream>
 #include <stdexcept>

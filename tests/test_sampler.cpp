@@ -1,8 +1,8 @@
 // kernels/sample.cl on PoCL against its C++ reference (HostSampler: the same
 // functions compiled by g++), and the determinism of the sampling kernel.
-#include <catch2/catch.hpp>
 #include <fmt/format.h>
 
+#include <catch2/catch.hpp>
 #include <cstring>
 
 #include "KernelCode.h"

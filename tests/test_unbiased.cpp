@@ -2,8 +2,9 @@
 // view along the normal) and, where there is none, against each other. Each pixel of a
 // uniform grid is an independent estimate of the same value, so the pixel mean has a
 // known standard error; fixed seeds make every z-score reproducible.
-#include <catch2/catch.hpp>
 #include <fmt/format.h>
+
+#include <catch2/catch.hpp>
 
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -52,8 +53,8 @@ TEST_CASE("every estimator is unbiased against 000 eq. 6.17", "[unbiased]") {
             MeanAndError r = renderMean(scene, m, e, 64, ++seed);
             double z = zScore(r.mean, expected, r.standardError);
             INFO(fmt::format("rhoD {} n {} K {} split {} cdf {} method {} one-sample {}: mean {} expected {} z {}",
-                             c.rhoD, c.n, c.K, split, s == EnvmapSampler::Cdf, methodName(m),
-                             e == Estimator::OneSample, r.mean, expected, z));
+                             c.rhoD, c.n, c.K, split, s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample,
+                             r.mean, expected, z));
             CHECK(std::abs(z) < kMaxZ);
           }
         }

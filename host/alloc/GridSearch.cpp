@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <chrono>
 #include <stdexcept>
+#include <cstdlib>
 
 #include "KernelCode.h"
 namespace misalloc::kern {
@@ -217,8 +218,8 @@ int GridSearchResult::fallbackCount() const {
 GridSearch::GridSearch(const Device& device, int techniqueCount) : device_(device), techniqueCount_(techniqueCount) {
     checkTechniqueCount(techniqueCount);
     cl::Program program = buildProgram(device, "gridsearch.cl",
-                                       fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_CHUNK={}",
-                                                   techniqueCount, gridChunk(techniqueCount)));
+                                       fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_CHUNK={} {}",
+                                                   techniqueCount, std::getenv("GS_CHUNK") ? std::atoi(std::getenv("GS_CHUNK")) : gridChunk(techniqueCount), std::getenv("GS_OPTS") ? std::getenv("GS_OPTS") : ""));
     kernel_ = cl::Kernel(program, "gridSearch");
 }
 

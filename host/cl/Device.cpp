@@ -68,7 +68,8 @@ Device openDevice(const std::string& spec) {
     if (it == all.end()) it = all.begin();
   } else if (spec == "gpu" || spec == "cpu") {
     it = pickType(spec == "gpu" ? CL_DEVICE_TYPE_GPU : CL_DEVICE_TYPE_CPU);
-    if (it == all.end()) throw InputError(fmt::format("--device {}: no {} device (see `misalloc devices`)", spec, spec));
+    if (it == all.end())
+      throw InputError(fmt::format("--device {}: no {} device (see `misalloc devices`)", spec, spec));
   } else {
     size_t used = 0;
     long index = -1;

@@ -1,9 +1,9 @@
 #include "paper/Density1D.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <utility>
-
-#include <fmt/format.h>
 
 #include "paper/Quadrature.h"
 

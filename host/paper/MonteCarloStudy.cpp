@@ -34,11 +34,16 @@ PixelSamples drawPilot(const Example1D& example, const std::vector<InverseCdfSam
 
 Allocation allocate(AllocationRule rule, const PixelSamples& samples, const std::vector<double>& costs) {
   switch (rule) {
-    case AllocationRule::Equal: return allocateEqual(samples.techniqueCount());
-    case AllocationRule::Heuristic: return allocateHeuristic(samples.stats(), costs);
-    case AllocationRule::SigmaSqrtC: return allocateSigmaSqrtC(samples.stats(), costs);
-    case AllocationRule::LinearDropMostNegative: return allocateLinear(samples, ZeroWeightRule::DropMostNegative);
-    case AllocationRule::LinearMinSampleVariance: return allocateLinear(samples, ZeroWeightRule::MinSampleVariance);
+    case AllocationRule::Equal:
+      return allocateEqual(samples.techniqueCount());
+    case AllocationRule::Heuristic:
+      return allocateHeuristic(samples.stats(), costs);
+    case AllocationRule::SigmaSqrtC:
+      return allocateSigmaSqrtC(samples.stats(), costs);
+    case AllocationRule::LinearDropMostNegative:
+      return allocateLinear(samples, ZeroWeightRule::DropMostNegative);
+    case AllocationRule::LinearMinSampleVariance:
+      return allocateLinear(samples, ZeroWeightRule::MinSampleVariance);
   }
   return allocateEqual(samples.techniqueCount());
 }
@@ -66,11 +71,16 @@ std::vector<AllocationRule> allAllocationRules() {
 
 std::string allocationRuleName(AllocationRule rule) {
   switch (rule) {
-    case AllocationRule::Equal: return "equal";
-    case AllocationRule::Heuristic: return "heuristic (000 eq. 4.20)";
-    case AllocationRule::SigmaSqrtC: return "sigma/sqrt(c) (002 eq. 31)";
-    case AllocationRule::LinearDropMostNegative: return "linear, drop most negative (003)";
-    case AllocationRule::LinearMinSampleVariance: return "linear, min sample variance (003)";
+    case AllocationRule::Equal:
+      return "equal";
+    case AllocationRule::Heuristic:
+      return "heuristic (000 eq. 4.20)";
+    case AllocationRule::SigmaSqrtC:
+      return "sigma/sqrt(c) (002 eq. 31)";
+    case AllocationRule::LinearDropMostNegative:
+      return "linear, drop most negative (003)";
+    case AllocationRule::LinearMinSampleVariance:
+      return "linear, min sample variance (003)";
   }
   return "";
 }

@@ -1,10 +1,10 @@
 #include "paper/PaperExamples.h"
 
-#include <cmath>
-#include <stdexcept>
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <cmath>
+#include <stdexcept>
 
 namespace misalloc {
 
@@ -63,7 +63,8 @@ Example1D example002(int number) {
       f = [](double x) { return x / 4.82082 + parabola(x) / 8.764 + std::sin(x) / 1.88816; };
       integrand = "x/4.82082 + (x^2 - x/pi)/8.764 + sin x/1.88816";
       break;
-    default: throw unknownExample(fmt::format("002-{}", number));
+    default:
+      throw unknownExample(fmt::format("002-{}", number));
   }
   return Example1D(fmt::format("002-{}", number),
                    fmt::format("002 App. A, Example {}: f = {} on [3/(2pi), pi]; techniques x, x^2 - x/pi, sin x",
@@ -123,7 +124,8 @@ Example1D example003(int number) {
       integrand = "(x^2 - x/pi) sin^2 x on [3/(2pi), pi]";
       pdfs = productTechniques(a, b);
       break;
-    default: throw unknownExample(fmt::format("003-{}", number));
+    default:
+      throw unknownExample(fmt::format("003-{}", number));
   }
   std::vector<std::string> names;
   for (const Density1D& p : pdfs) names.push_back(p.name());

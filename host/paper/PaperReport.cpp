@@ -1,11 +1,11 @@
 #include "paper/PaperReport.h"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <cmath>
 #include <ostream>
 #include <stdexcept>
-
-#include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include "alloc/HeuristicAllocation.h"
 #include "alloc/SigmaAllocation.h"
@@ -37,10 +37,14 @@ std::string numbers(const std::vector<double>& v) {
 
 std::string variance(const VarianceValue& v) {
   switch (v.status) {
-    case VarianceStatus::Finite: return number(v.value);
-    case VarianceStatus::Infinite: return "infinite";
-    case VarianceStatus::SignedDensity: return number(v.value) + " (formal: p < 0 where f = 0)";
-    case VarianceStatus::Undefined: return "undefined (p < 0 where f != 0)";
+    case VarianceStatus::Finite:
+      return number(v.value);
+    case VarianceStatus::Infinite:
+      return "infinite";
+    case VarianceStatus::SignedDensity:
+      return number(v.value) + " (formal: p < 0 where f = 0)";
+    case VarianceStatus::Undefined:
+      return "undefined (p < 0 where f != 0)";
   }
   return "";
 }

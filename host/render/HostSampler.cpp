@@ -68,12 +68,14 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
           kern::takeStageSample(ts, env, b, c, j, uint32_t(seed), uint32_t(seed >> 32), uint32_t(pixel));
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)
-        if (s.technique == slot / perTechnique) running[slot] += kern::statValue(int(config_.statsMask), slot % perTechnique, s);
+        if (s.technique == slot / perTechnique)
+          running[slot] += kern::statValue(int(config_.statsMask), slot % perTechnique, s);
       if (config_.sampleCapacity > 0) {
         int i = plan.samplesBefore + j;
         samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, M)] = float(s.technique);
         samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, M)] = s.y;
-        for (int l = 0; l < M; ++l) samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, M)] = s.pdfs[l];
+        for (int l = 0; l < M; ++l)
+          samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, M)] = s.pdfs[l];
       }
     }
     double* rgb = result.rgb.data() + size_t(pixel) * 3;

@@ -16,9 +16,12 @@ struct MethodName {
 };
 
 constexpr MethodName kMethods[] = {
-    {Method::Envmap, "envmap"}, {Method::Brdf, "brdf"},       {Method::Equal, "equal"},
-    {Method::Heuristic, "heuristic"}, {Method::SigmaSqrtC, "sigma-sqrt-c"}, {Method::Linear, "linear"},
-    {Method::Exact, "exact"},
+    {Method::Envmap, "envmap"},
+    {Method::Brdf, "brdf"},
+    {Method::Equal, "equal"},
+    {Method::Heuristic, "heuristic"},
+    {Method::SigmaSqrtC, "sigma-sqrt-c"},
+    {Method::Linear, "linear"},
 };
 
 std::string availableMethods() {
@@ -32,8 +35,8 @@ std::string availableMethods() {
 Method parseMethod(const std::string& name) {
   for (const auto& m : kMethods)
     if (name == m.name) return m.method;
-  if (name == "oracle")
-    throw InputError(fmt::format("--method oracle: not implemented yet (available: {})", availableMethods()));
+  if (name == "oracle" || name == "exact")
+    throw InputError(fmt::format("--method {}: not implemented yet (available: {})", name, availableMethods()));
   throw InputError(fmt::format("unknown --method '{}' (available: {})", name, availableMethods()));
 }
 
@@ -49,9 +52,7 @@ std::vector<Method> allMethods() {
   return all;
 }
 
-bool isAdaptive(Method method) {
-  return method != Method::Envmap && method != Method::Brdf && method != Method::Equal;
-}
+bool isAdaptive(Method method) { return method != Method::Envmap && method != Method::Brdf && method != Method::Equal; }
 
 Estimator methodEstimator(Method method) {
   return method == Method::SigmaSqrtC ? Estimator::CountIndependent : Estimator::MultiSample;
@@ -59,10 +60,14 @@ Estimator methodEstimator(Method method) {
 
 unsigned methodStatistics(Method method) {
   switch (method) {
-    case Method::Heuristic: return MA_STATS_TECHNIQUE;
-    case Method::SigmaSqrtC: return MA_STATS_BALANCE;
-    case Method::Linear: return MA_STATS_LINEAR;
-    default: return 0;
+    case Method::Heuristic:
+      return MA_STATS_TECHNIQUE;
+    case Method::SigmaSqrtC:
+      return MA_STATS_BALANCE;
+    case Method::Linear:
+      return MA_STATS_LINEAR;
+    default:
+      return 0;
   }
 }
 
@@ -72,7 +77,9 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
   const int M = scene.techniqueCount();
   std::vector<int> counts(M, 0);
   switch (method) {
-    case Method::Envmap: counts[0] = spp; break;
+    case Method::Envmap:
+      counts[0] = spp;
+      break;
     case Method::Brdf:
       if (M == 2) {
         counts[1] = spp;

@@ -21,7 +21,9 @@ struct Fnv1a {
   }
   void add(const std::string& s) { add(s.data(), s.size() + 1); }
   template <typename T>
-  void addValue(T v) { add(&v, sizeof v); }
+  void addValue(T v) {
+    add(&v, sizeof v);
+  }
 };
 
 }  // namespace

@@ -23,10 +23,14 @@ double secondsSince(Clock::time_point start) { return std::chrono::duration<doub
 Allocation allocatePixel(Method method, const AdaptiveOptions& options, const PixelStats& stats,
                          const PixelSamples* samples) {
   switch (method) {
-    case Method::Heuristic: return allocateHeuristic(stats, options.costs);  // 000 eq. 4.20
-    case Method::SigmaSqrtC: return allocateSigmaSqrtC(stats, options.costs);  // 002 eq. 31
-    case Method::Linear: return allocateLinear(*samples, options.linearRule);  // 003 eq. 14
-    default: throw std::logic_error("no per-pixel rule for " + methodName(method));
+    case Method::Heuristic:
+      return allocateHeuristic(stats, options.costs);  // 000 eq. 4.20
+    case Method::SigmaSqrtC:
+      return allocateSigmaSqrtC(stats, options.costs);  // 002 eq. 31
+    case Method::Linear:
+      return allocateLinear(*samples, options.linearRule);  // 003 eq. 14
+    default:
+      throw std::logic_error("no per-pixel rule for " + methodName(method));
   }
 }
 
@@ -70,9 +74,10 @@ std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techn
   if (stages < 1) throw InputError(fmt::format("--stages {}: need at least one stage after the pilot", stages));
   int pilot = std::max(2 * techniqueCount, int(std::lround(pilotFraction * spp)));
   if (spp < pilot + stages)
-    throw InputError(fmt::format("--spp {} is smaller than the pilot ({} samples: at least 2 per technique) plus {} "
-                                 "stage(s) of at least one sample",
-                                 spp, pilot, stages));
+    throw InputError(
+        fmt::format("--spp {} is smaller than the pilot ({} samples: at least 2 per technique) plus {} "
+                    "stage(s) of at least one sample",
+                    spp, pilot, stages));
   std::vector<int> sizes{pilot};
   for (int b = 0; b < stages; ++b) sizes.push_back((spp - pilot) / stages + (b < (spp - pilot) % stages ? 1 : 0));
   return sizes;

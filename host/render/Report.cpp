@@ -8,9 +8,12 @@ namespace misalloc {
 
 std::string estimatorName(Estimator estimator) {
   switch (estimator) {
-    case Estimator::MultiSample: return "multi-sample balance heuristic";
-    case Estimator::OneSample: return "one-sample balance heuristic";
-    case Estimator::CountIndependent: return "count-independent weights (002 eq. 26)";
+    case Estimator::MultiSample:
+      return "multi-sample balance heuristic";
+    case Estimator::OneSample:
+      return "one-sample balance heuristic";
+    case Estimator::CountIndependent:
+      return "count-independent weights (002 eq. 26)";
   }
   return "?";
 }
@@ -49,7 +52,9 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"seed", run.seed},
       {"device", run.device},
       {"time_s",
-       {{"wall", r.wallSeconds}, {"kernel", r.kernelSeconds}, {"allocation", r.allocationSeconds},
+       {{"wall", r.wallSeconds},
+        {"kernel", r.kernelSeconds},
+        {"allocation", r.allocationSeconds},
         {"host", r.hostSeconds}}},
       {"samples_per_second", double(pixels) * run.spp / r.kernelSeconds},
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
@@ -67,9 +72,9 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
     };
     if (run.method == Method::Linear)
-      report["allocation"]["zero_weight_rule"] =
-          run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance ? "min sample variance (003 eq. 19)"
-                                                                       : "drop most negative (003 Sec. 5.1)";
+      report["allocation"]["zero_weight_rule"] = run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance
+                                                     ? "min sample variance (003 eq. 19)"
+                                                     : "drop most negative (003 Sec. 5.1)";
   }
   if (run.reference) {
     report["reference"] = {{"source", run.reference->source}, {"path", run.reference->path}};

@@ -80,8 +80,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const size_t slots = std::max<size_t>(1, size_t(scene.pixelCount()) * statSlots());
   stats_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, slots * accSize);
   device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
-  samples_ = config.sampleCapacity > 0 ? upload(device, emptyStoredSamples(scene, config.sampleCapacity), CL_MEM_READ_WRITE)
-                                       : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  samples_ = config.sampleCapacity > 0
+                 ? upload(device, emptyStoredSamples(scene, config.sampleCapacity), CL_MEM_READ_WRITE)
+                 : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
   StagePlan empty;

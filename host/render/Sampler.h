@@ -25,7 +25,7 @@ class StageSampler {
 
   const Scene& scene() const { return scene_; }
   const SamplerConfig& config() const { return config_; }
-  int statSlots() const;  // running sums per pixel
+  int statSlots() const;             // running sums per pixel
   size_t storedSampleCount() const;  // floats in the stored-samples buffer
 
  protected:

@@ -28,8 +28,8 @@ std::string resolveEnvmapSpec(const std::string& spec) {
     fs::path candidate = fs::path(dir) / (spec + ".exr");
     if (fs::exists(candidate)) return candidate.string();
   }
-  throw InputError(fmt::format("--envmap '{}': no such file, and no shipped map of that name in {}", spec,
-                               fmt::join(dirs, ", ")));
+  throw InputError(
+      fmt::format("--envmap '{}': no such file, and no shipped map of that name in {}", spec, fmt::join(dirs, ", ")));
 }
 
 EnvmapSampler parseEnvmapSampler(const std::string& name) {

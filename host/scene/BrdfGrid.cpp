@@ -46,7 +46,8 @@ void checkParameters(const std::string& spec, double rhoD, double rhoS, double n
 float seed000Exponent(float x) { return float(-1.0 - 0.111211 / (0.1 * std::pow(double(x), 0.2) - 0.101101)); }
 
 BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height) {
-  if (width <= 0 || height <= 0) throw InputError(fmt::format("--size {}x{}: both sides must be positive", width, height));
+  if (width <= 0 || height <= 0)
+    throw InputError(fmt::format("--size {}x{}: both sides must be positive", width, height));
   auto colon = spec.find(':');
   std::string kind = spec.substr(0, colon);
   std::string args = colon == std::string::npos ? "" : spec.substr(colon + 1);
