@@ -44,8 +44,11 @@ StoredSampleLayout benchLayout() {
 }
 
 // Every pixel integrates its own f(x) = x^e + b on [0, 1] with the techniques
-// p_k = (k + 1) x^k, each sample's technique drawn from a random mixture: distinct,
-// well-posed searches with f > 0, so no sample is skipped by the peer.
+// p_k = (k + 1) x^k, in stages of kStageSamples as kernels/sample.cl stores them: each
+// stage's samples technique by technique, counts from the pixel's random mixture. The
+// searches are distinct and well posed, and f > 0, so no sample is skipped by the peer.
+constexpr int kStageSamples = 50;
+
 const std::vector<float>& benchSamples() {
     static const std::vector<float> samples = [] {
         StoredSampleLayout layout = benchLayout();
@@ -55,9 +58,11 @@ const std::vector<float>& benchSamples() {
         std::uniform_real_distribution<double> uniform(0.0, 1.0);
         for (int pixel = 0; pixel < (layout.pixelCount + 15) / 16 * 16; ++pixel) {
             double exponent = 0.5 + 2 * uniform(rng), offset = 0.05 + 0.5 * uniform(rng), mix = 0.2 + 0.6 * uniform(rng);
+            int firstCount = int(mix * kStageSamples);
             for (int i = 0; i < layout.taken; ++i) {
                 auto at = [&](int q) -> float& { return s[kern::storedSampleIndex(pixel, i, q, layout.capacity, m)]; };
-                int k = uniform(rng) < mix ? 0 : 1 + int(uniform(rng) * (m - 1));
+                int j = i % kStageSamples;
+                int k = j < firstCount ? 0 : 1 + (j - firstCount) * (m - 1) / (kStageSamples - firstCount);
                 double x = std::pow(uniform(rng), 1.0 / (k + 1));
                 at(0) = float(k);
                 at(1) = pixel < layout.pixelCount ? float(std::pow(x, exponent) + offset) : 0.0f;

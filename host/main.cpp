@@ -54,7 +54,15 @@ struct SceneArgs {
     options.viewTheta = theta;
     options.viewPhi = phi;
     options.sampler = parseEnvmapSampler(sampler);
-    return makeScene(options);
+    Scene scene = makeScene(options);
+    const ReadWarnings& repaired = scene.envmapWarnings;
+    if (repaired.negativeValues > 0)
+      std::cerr << fmt::format("misalloc: warning: {}: {} negative values set to 0 (first at {})\n", scene.envmapPath,
+                               repaired.negativeValues, toString(repaired.firstNegative));
+    if (scene.tables.uniformFallback)
+      std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: its sampling falls back to uniform\n",
+                               options.envmap);
+    return scene;
   }
 };
 
@@ -64,6 +72,12 @@ std::unique_ptr<StageSampler> makeSampler(const std::string& deviceSpec, std::un
   if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, config);
   if (!device) device = std::make_unique<Device>(openDevice(deviceSpec));
   return std::make_unique<Sampler>(*device, scene, config, localSize);
+}
+
+GridRule parseGridRule(const std::string& name) {
+  if (name == "variance") return GridRule::MinCostVariance;
+  if (name == "entropy") return GridRule::MaxEntropy;
+  throw InputError(fmt::format("--grid-rule '{}': expected variance or entropy", name));
 }
 
 ZeroWeightRule parseLinearRule(const std::string& name) {
@@ -105,6 +119,14 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--stages", adaptive.stages, "adaptive methods: stages after the pilot")->capture_default_str();
   renderCmd->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
   renderCmd->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
+      ->capture_default_str();
+  std::string gridRule = "variance";
+  renderCmd->add_option("--grid-u", adaptive.gridSize, "exact, oracle: number U of weight combinations searched")
+      ->capture_default_str();
+  renderCmd->add_option("--grid-rule", gridRule,
+                        "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
+      ->capture_default_str();
+  renderCmd->add_option("--oracle-spp", adaptive.oracleSamples, "oracle: probe samples per pixel")
       ->capture_default_str();
   renderCmd->add_option("--alpha-map", alphaMap, "write the per-pixel allocation: EXR here, false-colour PNG beside");
   renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi (000 eq. 4.1) or one (one-sample MIS)")
@@ -156,6 +178,12 @@ int main(int argc, char** argv) {
       if (isAdaptive(m) && estimator != Estimator::MultiSample)
         throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", estimatorName));
       adaptive.linearRule = parseLinearRule(linearRule);
+      adaptive.gridRule = parseGridRule(gridRule);
+      if (adaptive.gridSize < 2)
+        throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", adaptive.gridSize));
+      if (adaptive.oracleSamples < 2 * 3)
+        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
+                                     adaptive.oracleSamples));
       checkWritableOutput(out, "--out");
       checkWritableOutput(reportPath, "--report");
       if (!alphaMap.empty()) {
@@ -167,7 +195,7 @@ int main(int argc, char** argv) {
       std::string costSource = "--cost";
       if (!costList.empty()) adaptive.costs = parseCosts(costList, scene.techniqueCount());
       std::unique_ptr<Device> device;
-      SamplerConfig config = samplerConfigFor(m, estimator, spp);
+      SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
       auto sampler = makeSampler(deviceSpec, device, scene, config, localSize);
       std::string deviceName = device ? device->name() : "host (C++ reference, OpenMP)";
       // Without statistics: for the reference and for measuring costs.

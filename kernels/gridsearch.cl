@@ -1,214 +1,103 @@
-// 000 Algorithm 1, lines 5–13, for every pixel at once: each work-item searches the U
-// weight combinations for 16 pixels, one per float16 lane, over the samples that
-// kernels/sample.cl stored in the blocked layout of kernels/stats.h (storedSampleIndex).
-// Host side: host/alloc/GridSearch.h; C++ reference: gridSearchReference there.
+// 000 Algorithm 1, lines 5–13, for every pixel at once: one work-item per pixel
+// searches the U weight combinations, 16 of them per float16, over the samples that
+// kernels/sample.cl stored (kernels/stats.h, storedSampleIndex). Host side and C++
+// reference: host/alloc/GridSearch.h. What both share: kernels/gridsearch.h.
 //
-// Compile-time options (gridSearchOptions in host/alloc/GridSearch.cpp): MA_TECHNIQUES
-// (M) and MA_GRID_CHUNK, the weight combinations summed in one pass over the samples.
+// Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M) and
+// MA_GRID_VECTORS (B), the float16s of combinations summed in one pass over the samples.
 //
-// Shape (../shared/notes/pocl-performance.md): explicit float16 arithmetic reaches
-// 512-bit code on PoCL, and MA_GRID_CHUNK · 2M accumulators are as many independent
-// fma chains. Sums are float: g is scaled so that g ≤ 1/min α (no overflow), and the
-// few hundred samples of a pixel lose ~√n ulps, far below the sampling noise of the
-// estimates they feed.
+// Shape (../shared/notes/pocl-performance.md): explicit float16 arithmetic is what
+// reaches 512-bit code on PoCL. Lanes are combinations, not pixels, so a sample's
+// technique is the same in every lane: its sums need no masks. A division has the same
+// throughput per lane at 512 and 256 bits, so the B quotients f/p_α of one sample
+// share one (MA_BATCH_QUOTIENTS), leaving multiplies, and 2B independent accumulator
+// chains. Sums are float: the scaling keeps g ≤ 1/min α, and summing a few hundred
+// samples in order loses ~√n ulps, far below the sampling noise of the estimates.
 #include "gridsearch.h"
 
-#define MA_RECORD (MA_TECHNIQUES + 2)  // floats per stored sample: technique, f, p_0 … p_{M−1}
+#define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
 
-// One stored sample of 16 pixels.
-typedef struct {
-  float16 technique, f, pdf[MA_TECHNIQUES];
-} SampleLanes;
-
-MA_FN SampleLanes loadSample(__global const float* block, int i) {
-  SampleLanes s;
-  s.technique = vload16(i * MA_RECORD, block);
-  s.f = vload16(i * MA_RECORD + 1, block);
+// Σ g and Σ g² of one technique's samples for the combinations l0 … l0 + MA_PASS − 1
+// (000 Alg. 1 line 8; eq. 6.6 and 6.8 before dividing by m_j). alpha[c][k] holds α_k
+// of the 16 combinations of vector c.
+MA_FN void sumTechnique(__global const float* pixelSamples, int taken, int j, float scale,
+                        const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES], float* sumG, float* sumG2) {
+  float16 s[MA_GRID_VECTORS], s2[MA_GRID_VECTORS];
   MA_UNROLL
-  for (int k = 0; k < MA_TECHNIQUES; ++k) s.pdf[k] = vload16(i * MA_RECORD + 2 + k, block);
-  return s;
-}
-
-MA_FN float16 pdfSum(SampleLanes s) {
-  float16 sum = s.pdf[0];
-  MA_UNROLL
-  for (int k = 1; k < MA_TECHNIQUES; ++k) sum += s.pdf[k];
-  return sum;
-}
-
-// 1 where lane's sample was drawn by technique j, else 0: the technique's sums take
-// t_j · g, which is exact.
-MA_FN float16 techniqueMask(SampleLanes s, int j) { return select((float16)0.0f, (float16)1.0f, s.technique == (float)j); }
-
-// What pixelFallbacks needs, per lane, and the scale of g: 1 / max_i f_i / Σ_k p_k(x_i).
-// Since p_α ≥ (min_k α_k) Σ_k p_k, every scaled g is at most 1 / min_k α_k.
-typedef struct {
-  float count[MA_TECHNIQUES][16], maxF[MA_TECHNIQUES][16];
-  float16 scale;
-  int16 invalid;
-} BlockSummary;
-
-MA_FN BlockSummary summarise(__global const float* block, int taken) {
-  float16 count[MA_TECHNIQUES], maxF[MA_TECHNIQUES], maxRatio = 0.0f;
-  int16 invalid = 0;
-  MA_UNROLL
-  for (int j = 0; j < MA_TECHNIQUES; ++j) count[j] = maxF[j] = 0.0f;
+  for (int c = 0; c < MA_GRID_VECTORS; ++c) s[c] = s2[c] = 0.0f;
   for (int i = 0; i < taken; ++i) {
-    SampleLanes s = loadSample(block, i);
-    float16 pSum = pdfSum(s), drawn = 0.0f;
-    invalid |= !(s.f >= 0.0f && s.f <= FLT_MAX) | (s.f > 0.0f && pSum == 0.0f);
+    // kernels/sample.cl stores each stage's samples technique by technique, so this
+    // branch is predictable.
+    if ((int)storedValue(pixelSamples, MA_TECHNIQUES, i, 0) != j) continue;
+    ScaledSample x = scaledSample(pixelSamples, MA_TECHNIQUES, i, scale);
+    float16 p[MA_GRID_VECTORS], g[MA_GRID_VECTORS];
     MA_UNROLL
-    for (int k = 0; k < MA_TECHNIQUES; ++k) invalid |= !(s.pdf[k] >= 0.0f && s.pdf[k] <= FLT_MAX);
-    maxRatio = fmax(maxRatio, s.f / select(pSum, (float16)1.0f, pSum == 0.0f));
-    MA_UNROLL
-    for (int j = 0; j < MA_TECHNIQUES; ++j) {
-      float16 t = techniqueMask(s, j);
-      count[j] += t;
-      maxF[j] = fmax(maxF[j], t * s.f);
-      drawn += t;
+    for (int c = 0; c < MA_GRID_VECTORS; ++c) {
+      p[c] = alpha[c][0] * x.q[0];
+      MA_UNROLL
+      for (int k = 1; k < MA_TECHNIQUES; ++k) p[c] = fma(alpha[c][k], (float16)x.q[k], p[c]);
     }
-    invalid |= drawn == 0.0f;  // a technique index outside 0 … M−1
+    MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x.f, p, g);
+    MA_UNROLL
+    for (int c = 0; c < MA_GRID_VECTORS; ++c) {
+      s[c] += g[c];
+      s2[c] = fma(g[c], g[c], s2[c]);
+    }
   }
-  BlockSummary summary;
   MA_UNROLL
-  for (int j = 0; j < MA_TECHNIQUES; ++j) {
-    vstore16(count[j], 0, summary.count[j]);
-    vstore16(maxF[j], 0, summary.maxF[j]);
+  for (int c = 0; c < MA_GRID_VECTORS; ++c) {
+    vstore16(s[c], c, sumG);
+    vstore16(s2[c], c, sumG2);
   }
-  summary.scale = select(1.0f / maxRatio, (float16)1.0f, maxRatio == 0.0f);
-  summary.invalid = invalid;
-  return summary;
 }
 
-// Σ g and Σ g² over each technique's samples, g = scale · f / p_α, for MA_GRID_CHUNK
-// weight combinations (000 Alg. 1 line 8; eq. 6.6 and 6.8 before dividing by m_j).
-typedef struct {
-  float sumG[MA_GRID_CHUNK][MA_TECHNIQUES][16], sumG2[MA_GRID_CHUNK][MA_TECHNIQUES][16];
-} ChunkSums;
-
-MA_FN ChunkSums sumChunk(__global const float* block, int taken, float16 scale,
-                         const float alpha[MA_GRID_CHUNK][MA_TECHNIQUES]) {
-  float16 sumG[MA_GRID_CHUNK][MA_TECHNIQUES], sumG2[MA_GRID_CHUNK][MA_TECHNIQUES];
-  MA_UNROLL
-  for (int c = 0; c < MA_GRID_CHUNK; ++c) {
-    MA_UNROLL
-    for (int j = 0; j < MA_TECHNIQUES; ++j) sumG[c][j] = sumG2[c][j] = 0.0f;
-  }
-  for (int i = 0; i < taken; ++i) {
-    SampleLanes s = loadSample(block, i);
-    float16 fs = s.f * scale;
-    // Where every p_k = 0, f = 0 as well (else the lane fell back): g must be 0 there,
-    // not 0/0, and p_0 = 1 makes p_α = α_0 > 0.
-    s.pdf[0] = select(s.pdf[0], (float16)1.0f, pdfSum(s) == 0.0f);
-    float16 t[MA_TECHNIQUES];
-    MA_UNROLL
-    for (int j = 0; j < MA_TECHNIQUES; ++j) t[j] = techniqueMask(s, j);
-    MA_UNROLL
-    for (int c = 0; c < MA_GRID_CHUNK; ++c) {
-      float16 p = alpha[c][0] * s.pdf[0];
-      MA_UNROLL
-      for (int k = 1; k < MA_TECHNIQUES; ++k) p = fma((float16)alpha[c][k], s.pdf[k], p);
-#if MA_RECIP_MODE == 1
-      float16 r = as_float16((uint16)0x7EF311C3u - as_uint16(p));
-      r = fma(r, fma(-p, r, 1.0f), r);
-      r = fma(r, fma(-p, r, 1.0f), r);
-      r = fma(r, fma(-p, r, 1.0f), r);
-      float16 g = fs * r;
-#elif MA_RECIP_MODE == 2
-      float16 g = native_divide(fs, p);
-#else
-      float16 g = fs / p;
-#endif
-      MA_UNROLL
-      for (int j = 0; j < MA_TECHNIQUES; ++j) {
-        float16 tg = t[j] * g;
-        sumG[c][j] += tg;
-        sumG2[c][j] = fma(tg, g, sumG2[c][j]);
-      }
-    }
-  }
-  ChunkSums sums;
-  MA_UNROLL
-  for (int c = 0; c < MA_GRID_CHUNK; ++c) {
-    MA_UNROLL
-    for (int j = 0; j < MA_TECHNIQUES; ++j) {
-      vstore16(sumG[c][j], 0, sums.sumG[c][j]);
-      vstore16(sumG2[c][j], 0, sums.sumG2[c][j]);
-    }
-  }
-  return sums;
-}
-
-// One work-item per 16 pixels. Outputs per pixel: α (M floats), the selected index l₀
-// (−1 where the pixel fell back to equal weights) and AllocationFallback bits.
-// gridAlpha[l·M + k] = α_{k,l}, gridCost[l] = Σ_k c_k α_{k,l}, cost[k] = c_k.
+// One work-item per pixel. gridLanes[k · paddedSize + l] = α_{k,l} (padded past
+// gridSize with the last combination), gridCost[l] = Σ_k c_k α_{k,l}, cost[k] = c_k.
+// Outputs per pixel: α (M floats), the selected index l₀ (−1 where the pixel fell back
+// to equal weights) and AllocationFallback bits.
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
-                         __global const float* gridAlpha, __global const float* gridCost, int gridSize,
-                         __global const float* cost, int rule, __global float* alphaOut, __global int* selectedOut,
-                         __global uint* fallbacksOut) {
-  int block = (int)get_global_id(0);
-  if (16 * block >= pixelCount) return;
-  __global const float* blockSamples = samples + (size_t)block * capacity * MA_RECORD * 16;
-  BlockSummary summary = summarise(blockSamples, taken);
-  int invalid[16];
-  vstore16(summary.invalid, 0, invalid);
-
-  float c[MA_TECHNIQUES], bestScore[16];
-  MA_UNROLL
-  for (int k = 0; k < MA_TECHNIQUES; ++k) c[k] = cost[k];
-  int best[16], searchable = 0;
-  uint fallbacks[16];
-  for (int lane = 0; lane < 16; ++lane) {
-    float count[MA_TECHNIQUES], maxF[MA_TECHNIQUES];
-    for (int j = 0; j < MA_TECHNIQUES; ++j) {
-      count[j] = summary.count[j][lane];
-      maxF[j] = summary.maxF[j][lane];
-    }
-    fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, count, maxF, invalid[lane]);
-    searchable |= fallbacks[lane] == 0u && 16 * block + lane < pixelCount;
-    bestScore[lane] = -INFINITY;
-    best[lane] = -1;
+                         __global const float* gridLanes, __global const float* gridCost, int gridSize,
+                         int paddedSize, __global const float* cost, int rule, __global float* alphaOut,
+                         __global int* selectedOut, __global uint* fallbacksOut) {
+  int pixel = (int)get_global_id(0);
+  if (pixel >= pixelCount) return;
+  __global const float* pixelSamples = samples + (size_t)(pixel / 16) * capacity * (MA_TECHNIQUES + 2) * 16 + pixel % 16;
+  PixelSummary summary = summarisePixel(pixelSamples, MA_TECHNIQUES, taken);
+  uint fallbacks = pixelFallbacks(MA_TECHNIQUES, summary);
+  float c[MA_TECHNIQUES], invCount[MA_TECHNIQUES];
+  for (int k = 0; k < MA_TECHNIQUES; ++k) {
+    c[k] = cost[k];
+    invCount[k] = 1.0f / summary.count[k];
   }
-
-  for (int l0 = 0; searchable && l0 < gridSize; l0 += MA_GRID_CHUNK) {
-    // A last chunk past the grid repeats its final combination, which never wins a tie.
-    float alpha[MA_GRID_CHUNK][MA_TECHNIQUES], meanCost[MA_GRID_CHUNK];
-    for (int ci = 0; ci < MA_GRID_CHUNK; ++ci) {
-      int l = min(l0 + ci, gridSize - 1);
-      meanCost[ci] = gridCost[l];
-      for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[ci][k] = gridAlpha[l * MA_TECHNIQUES + k];
-    }
-    ChunkSums sums = sumChunk(blockSamples, taken, summary.scale, alpha);
-    for (int lane = 0; lane < 16; ++lane) {
-      if (fallbacks[lane] != 0u) continue;
-      float count[MA_TECHNIQUES];
-      for (int j = 0; j < MA_TECHNIQUES; ++j) count[j] = summary.count[j][lane];
-      for (int ci = 0; ci < MA_GRID_CHUNK; ++ci) {
-        float sumG[MA_TECHNIQUES], sumG2[MA_TECHNIQUES];
-        for (int j = 0; j < MA_TECHNIQUES; ++j) {
-          sumG[j] = sums.sumG[ci][j][lane];
-          sumG2[j] = sums.sumG2[ci][j][lane];
-        }
-        float score = gridScore(rule, MA_TECHNIQUES, alpha[ci], meanCost[ci], c, sumG, sumG2, count);
-        if (score > bestScore[lane]) {
-          bestScore[lane] = score;
-          best[lane] = min(l0 + ci, gridSize - 1);
-        }
+  float bestScore = -INFINITY;
+  int best = -1;
+  for (int l0 = 0; fallbacks == 0u && l0 < gridSize; l0 += MA_PASS) {
+    float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES];
+    for (int v = 0; v < MA_GRID_VECTORS; ++v)
+      for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[v][k] = vload16(0, gridLanes + k * paddedSize + l0 + 16 * v);
+    float sumG[MA_TECHNIQUES][MA_PASS], sumG2[MA_TECHNIQUES][MA_PASS];
+    for (int j = 0; j < MA_TECHNIQUES; ++j)
+      sumTechnique(pixelSamples, taken, j, summary.scale, alpha, sumG[j], sumG2[j]);
+    for (int n = 0; n < MA_PASS && l0 + n < gridSize; ++n) {
+      float a[MA_TECHNIQUES], g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
+      for (int j = 0; j < MA_TECHNIQUES; ++j) {
+        a[j] = gridLanes[j * paddedSize + l0 + n];
+        g1[j] = sumG[j][n];
+        g2[j] = sumG2[j][n];
+      }
+      float score = gridScore(rule, MA_TECHNIQUES, a, gridCost[l0 + n], c, g1, g2, invCount);
+      if (score > bestScore) {
+        bestScore = score;
+        best = l0 + n;
       }
     }
   }
-
-  for (int lane = 0; lane < 16; ++lane) {
-    int pixel = 16 * block + lane;
-    if (pixel >= pixelCount) break;
-    // No combination could be ranked: non-finite sums, or for rule (a) no λ that is a
-    // distribution (eq. 4.16 has no solution on the grid).
-    if (fallbacks[lane] == 0u && best[lane] < 0)
-      fallbacks[lane] = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
-    for (int k = 0; k < MA_TECHNIQUES; ++k)
-      alphaOut[pixel * MA_TECHNIQUES + k] =
-          fallbacks[lane] == 0u ? gridAlpha[best[lane] * MA_TECHNIQUES + k] : 1.0f / MA_TECHNIQUES;
-    selectedOut[pixel] = fallbacks[lane] == 0u ? best[lane] : -1;
-    fallbacksOut[pixel] = fallbacks[lane];
-  }
+  // No combination could be ranked: non-finite sums, or for rule (a) no λ that is a
+  // distribution (eq. 4.16 has no solution on the grid).
+  if (fallbacks == 0u && best < 0)
+    fallbacks = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
+  for (int k = 0; k < MA_TECHNIQUES; ++k)
+    alphaOut[pixel * MA_TECHNIQUES + k] = fallbacks == 0u ? gridLanes[k * paddedSize + best] : 1.0f / MA_TECHNIQUES;
+  selectedOut[pixel] = fallbacks == 0u ? best : -1;
+  fallbacksOut[pixel] = fallbacks;
 }

@@ -1,7 +1,8 @@
-// Paper 000's Algorithm 1 ("exact" allocation) for one pixel: the per-pixel decisions
-// that the OpenCL kernel (kernels/gridsearch.cl, 16 pixels per work-item) and its C++
-// reference (host/alloc/GridSearch.cpp) share, so both rank the weight combinations
-// with the same code. The sums over the stored samples are each side's own loop.
+// Paper 000's Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
+// kernel (kernels/gridsearch.cl) and its C++ reference (host/alloc/GridSearch.cpp)
+// share, so that both compute bit for bit the same sums and rank the weight
+// combinations with the same code. Only the loop over samples × combinations is each
+// side's own: float16 over 16 combinations in the kernel, plain loops in C++.
 #ifndef MA_GRIDSEARCH_H
 #define MA_GRIDSEARCH_H
 #include "fastmath.h"
@@ -19,36 +20,130 @@
 #define MA_FALLBACK_SILENT_TECHNIQUE 8u
 #define MA_FALLBACK_SINGULAR_SYSTEM 64u
 
-// Why a pixel's stored samples cannot be searched, from their summary: `invalid` (a
-// NaN, infinite or negative f or pdf, f > 0 where every pdf is 0, or a technique index
-// outside 0 … M−1), the count m_j and the largest f of each technique. Every reason
-// gives equal weights. A variance estimate needs m_j ≥ 2. A technique whose samples
-// all have f = 0 has μ_j = ν_j = 0: cost × variance would then favour it for free, and
-// eq. 4.16 has no solution with α_j > 0 (Λ_j = c_j V ≥ 0 while Σ_j α_j Λ_j < 0), so
-// the grid cannot be ranked.
-MA_FN ma_uint pixelFallbacks(int techniqueCount, const float* count, const float* maxF, int invalid) {
-  if (invalid) return MA_FALLBACK_NON_FINITE;
+// Value q of a pixel's sample i, with `pixelSamples` at the pixel's first value: the
+// layout of kernels/stats.h (storedSampleIndex), records of M + 2 rows of 16 pixels.
+MA_FN float storedValue(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, int q) {
+  return pixelSamples[(i * (techniqueCount + 2) + q) * 16];
+}
+
+// 2^−e for x = m · 2^e, m ∈ [1, 2): x · 2^−e ∈ [1, 2). Exponents are clamped so that
+// the result stays a normal float.
+MA_FN float inversePowerOfTwo(float x) {
+  int e = (int)((ma_as_uint(x) >> 23) & 0xffu);
+  e = e < 1 ? 1 : (e > 253 ? 253 : e);
+  return ma_as_float((ma_uint)(254 - e) << 23);
+}
+
+// What decides whether a pixel can be searched (pixelFallbacks), and the scale of g.
+typedef struct {
+  float count[MA_GRID_MAX_TECHNIQUES];  // m_j
+  float maxF[MA_GRID_MAX_TECHNIQUES];   // the largest f of technique j; 0: silent
+  // 1 / max_i f_i / Σ_k p_k(x_i). Since p_α ≥ (min_k α_k) Σ_k p_k, every scaled
+  // g = scale · f / p_α is at most 1 / min_k α_k: float sums cannot overflow.
+  float scale;
+  int invalid;  // a NaN, infinite or negative f or pdf, f > 0 where every pdf is 0,
+                // or a technique index outside 0 … M−1
+} PixelSummary;
+
+MA_FN PixelSummary summarisePixel(MA_GLOBAL const float* pixelSamples, int techniqueCount, int taken) {
+  PixelSummary s;
+  for (int j = 0; j < MA_GRID_MAX_TECHNIQUES; ++j) s.count[j] = s.maxF[j] = 0.0f;
+  s.invalid = 0;
+  float maxRatio = 0.0f;
+  for (int i = 0; i < taken; ++i) {
+    float technique = storedValue(pixelSamples, techniqueCount, i, 0);
+    float f = storedValue(pixelSamples, techniqueCount, i, 1), pSum = 0.0f;
+    for (int k = 0; k < techniqueCount; ++k) {
+      float p = storedValue(pixelSamples, techniqueCount, i, 2 + k);
+      s.invalid |= !(p >= 0.0f && p <= FLT_MAX);
+      pSum += p;
+    }
+    int j = technique >= 0.0f && technique < (float)techniqueCount ? (int)technique : -1;
+    if (!(f >= 0.0f && f <= FLT_MAX) || (f > 0.0f && pSum == 0.0f) || j < 0 || (float)j != technique) {
+      s.invalid = 1;
+      continue;
+    }
+    maxRatio = ma_max(maxRatio, pSum > 0.0f ? f / pSum : 0.0f);
+    s.count[j] += 1.0f;
+    s.maxF[j] = ma_max(s.maxF[j], f);
+  }
+  s.scale = maxRatio > 0.0f ? 1.0f / maxRatio : 1.0f;
+  return s;
+}
+
+// Why a pixel cannot be searched; every reason gives equal weights. A variance
+// estimate needs m_j ≥ 2. A technique whose samples all have f = 0 has μ_j = ν_j = 0:
+// cost × variance would then favour it for free, and eq. 4.16 has no solution with
+// α_j > 0 (Λ_j = c_j V ≥ 0 while Σ_j α_j Λ_j < 0), so the grid cannot be ranked.
+MA_FN ma_uint pixelFallbacks(int techniqueCount, PixelSummary s) {
+  if (s.invalid) return MA_FALLBACK_NON_FINITE;
   ma_uint bits = 0;
   int signal = 0;
   for (int j = 0; j < techniqueCount; ++j) {
-    bits |= count[j] < 2.0f ? MA_FALLBACK_TOO_FEW_SAMPLES : 0u;
-    signal |= maxF[j] > 0.0f;
+    bits |= s.count[j] < 2.0f ? MA_FALLBACK_TOO_FEW_SAMPLES : 0u;
+    signal |= s.maxF[j] > 0.0f;
   }
   if (bits != 0) return bits;
   if (!signal) return MA_FALLBACK_NO_SIGNAL;
-  for (int j = 0; j < techniqueCount; ++j) bits |= maxF[j] > 0.0f ? 0u : MA_FALLBACK_SILENT_TECHNIQUE;
+  for (int j = 0; j < techniqueCount; ++j) bits |= s.maxF[j] > 0.0f ? 0u : MA_FALLBACK_SILENT_TECHNIQUE;
   return bits;
 }
 
-// Rule (b): −(Σ_k c_k α_k) V_multi, with the multi-sample balance-heuristic variance for
-// N = 1 (002 eq. 21, Table 2: V = Σ_j α_j σ'_j² with σ'_j² the variance of g = f/p_α
-// under p_j), estimated with 000 eq. 6.6 and 6.8 from technique j's samples:
-// σ'_j² = ν_j − μ_j². Cancellation can leave a tiny negative number, which is 0.
+// Sample i as the grid loop uses it: f and the pdfs multiplied by the same power of
+// two, so that Σ_k q_k ∈ [1, 2) and p_α ∈ [min α, 2): a product of a few p_α neither
+// overflows nor underflows (MA_BATCH_QUOTIENTS). f also takes the pixel's scale.
+// Where every pdf is 0, f = 0 too (else the pixel fell back); q_0 = 1 then keeps
+// p_α > 0, so that g = 0 rather than 0/0.
+typedef struct {
+  int technique;
+  float f;
+  float q[MA_GRID_MAX_TECHNIQUES];
+} ScaledSample;
+
+MA_FN ScaledSample scaledSample(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, float scale) {
+  ScaledSample s;
+  s.technique = (int)storedValue(pixelSamples, techniqueCount, i, 0);
+  float pSum = 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) {
+    s.q[k] = storedValue(pixelSamples, techniqueCount, i, 2 + k);
+    pSum += s.q[k];
+  }
+  float normalise = inversePowerOfTwo(pSum);
+  for (int k = 0; k < techniqueCount; ++k) s.q[k] *= normalise;
+  s.q[0] = pSum > 0.0f ? s.q[0] : 1.0f;
+  s.f = storedValue(pixelSamples, techniqueCount, i, 1) * scale * normalise;
+  return s;
+}
+
+// r_c = numerator / x_c for c < count with one division (Montgomery's batch
+// inversion): prefix products P_c = x_0 ⋯ x_c, then q = numerator / P_{count−1} and,
+// walking back, r_c = q · P_{c−1}, q ← q · x_c, r_0 = q. Each r_c carries about
+// count + 1 roundings instead of one. A macro so that the kernel (T = float16) and the
+// reference (T = float) run the same operations in the same order.
+#define MA_BATCH_QUOTIENTS(T, count, numerator, x, r)                                 \
+  do {                                                                                \
+    T prefix_[count];                                                                 \
+    prefix_[0] = (x)[0];                                                              \
+    MA_UNROLL for (int c_ = 1; c_ < (count); ++c_) prefix_[c_] = prefix_[c_ - 1] * (x)[c_]; \
+    T q_ = (numerator) / prefix_[(count) - 1];                                        \
+    MA_UNROLL for (int c_ = (count) - 1; c_ > 0; --c_) {                              \
+      (r)[c_] = q_ * prefix_[c_ - 1];                                                 \
+      q_ = q_ * (x)[c_];                                                              \
+    }                                                                                 \
+    (r)[0] = q_;                                                                      \
+  } while (0)
+
+// Rule (b): −(Σ_k c_k α_k) V, with V the variance of the multi-sample balance heuristic
+// for N = 1 (002 eq. 21 and Table 2): V = ∫ f²/p_α − Σ_j μ'_j²/α_j with
+// μ'_j = ∫ α_j p_j f / p_α = α_j μ_j, and ∫ f²/p_α = Σ_j α_j ν_j, so V = Σ_j α_j (ν_j − μ_j²),
+// μ_j = E_j[g] and ν_j = E_j[g²] under technique j's pdf, g = f/p_α. They are estimated
+// from technique j's m_j samples by 000 eq. 6.6 and 6.8. Cancellation can leave a
+// tiny negative ν_j − μ_j², which is 0.
 MA_FN float costVarianceScore(int techniqueCount, const float* alpha, float meanCost, const float* sumG,
-                              const float* sumG2, const float* count) {
+                              const float* sumG2, const float* invCount) {
   float variance = 0.0f;
   for (int j = 0; j < techniqueCount; ++j) {
-    float mu = sumG[j] / count[j], nu = sumG2[j] / count[j];
+    float mu = sumG[j] * invCount[j], nu = sumG2[j] * invCount[j];
     variance = ma_fma(alpha[j], ma_max(ma_fma(-mu, mu, nu), 0.0f), variance);
   }
   return -(meanCost * variance);
@@ -60,16 +155,16 @@ MA_FN float costVarianceScore(int techniqueCount, const float* alpha, float mean
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.
 MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost, const float* cost,
-                         const float* sumG, const float* sumG2, const float* count) {
+                         const float* sumG, const float* sumG2, const float* invCount) {
   float mu = 0.0f, secondMoment = 0.0f;
   for (int j = 0; j < techniqueCount; ++j) {
-    mu = ma_fma(alpha[j], sumG[j] / count[j], mu);
-    secondMoment = ma_fma(alpha[j], sumG2[j] / count[j], secondMoment);
+    mu = ma_fma(alpha[j], sumG[j] * invCount[j], mu);
+    secondMoment = ma_fma(alpha[j], sumG2[j] * invCount[j], secondMoment);
   }
   float variance = ma_max(ma_fma(-mu, mu, secondMoment), 0.0f);
   float Lambda[MA_GRID_MAX_TECHNIQUES], total = 0.0f;
   for (int j = 0; j < techniqueCount; ++j) {
-    Lambda[j] = ma_fma(cost[j], variance, -meanCost * (sumG2[j] / count[j]));
+    Lambda[j] = ma_fma(cost[j], variance, -meanCost * (sumG2[j] * invCount[j]));
     total += Lambda[j];
   }
   float entropy = 0.0f;
@@ -83,11 +178,11 @@ MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost,
 }
 
 // The score of weight combination α (cost Σ_k c_k α_k = meanCost) for one pixel, from
-// the sums of g = f/p_α and g² over each technique's samples. Larger is better.
+// the sums of g = f/p_α and g² over each technique's samples and 1/m_j. Larger is better.
 MA_FN float gridScore(int rule, int techniqueCount, const float* alpha, float meanCost, const float* cost,
-                      const float* sumG, const float* sumG2, const float* count) {
-  return rule == MA_RULE_MAX_ENTROPY ? entropyScore(techniqueCount, alpha, meanCost, cost, sumG, sumG2, count)
-                                     : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2, count);
+                      const float* sumG, const float* sumG2, const float* invCount) {
+  return rule == MA_RULE_MAX_ENTROPY ? entropyScore(techniqueCount, alpha, meanCost, cost, sumG, sumG2, invCount)
+                                     : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2, invCount);
 }
 
 #endif

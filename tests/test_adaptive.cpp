@@ -19,7 +19,8 @@ namespace {
 Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed) {
   AdaptiveOptions options;
   options.costs.assign(scene.techniqueCount(), 1.0);
-  Sampler sampler(testDevice(), scene, samplerConfigFor(method, Estimator::MultiSample, spp));
+  options.oracleSamples = 128;
+  Sampler sampler(testDevice(), scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
   return render(sampler, method, options, spp, seed);
 }
 
@@ -40,7 +41,7 @@ TEST_CASE("stage sizes follow the pilot share and sum to the budget", "[adaptive
 
 TEST_CASE("adaptive methods spend exactly the budget of every pixel", "[adaptive]") {
   Scene scene = smallScene("forest_slope", "seed000", 24, 16, true);
-  for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
+  for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle}) {
     Rendering r = renderWith(scene, m, 50, 3);
     const int M = scene.techniqueCount();
     size_t wrong = 0;
@@ -55,7 +56,7 @@ TEST_CASE("adaptive methods spend exactly the budget of every pixel", "[adaptive
     }
     INFO(methodName(m));
     CHECK(wrong == 0);
-    CHECK(r.stageCount == 5);
+    CHECK(r.stageCount == (m == Method::Oracle ? 1 : 5));
   }
 }
 
@@ -72,7 +73,7 @@ TEST_CASE("adaptive estimates are unbiased against 000 eq. 6.17", "[adaptive][un
     for (bool split : {false, true}) {
       Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n),
                                32, 32, split);
-      for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
+      for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle}) {
         MeanAndError r = imageMean(renderWith(scene, m, 60, ++seed).image);
         double z = (r.mean - expected) / std::max(r.standardError, 1e-6 * expected);
         INFO(fmt::format("rhoD {} n {} K {} split {} {}: mean {} expected {} z {}", c.rhoD, c.n, c.K, split,
@@ -85,7 +86,7 @@ TEST_CASE("adaptive estimates are unbiased against 000 eq. 6.17", "[adaptive][un
 
 TEST_CASE("adaptive renders are bit-identical for the same seed", "[adaptive][determinism]") {
   Scene scene = smallScene("rooitou_park", "seed000", 24, 16);
-  for (Method m : {Method::Heuristic, Method::Linear}) {
+  for (Method m : {Method::Heuristic, Method::Linear, Method::Exact}) {
     Rendering a = renderWith(scene, m, 40, 11), b = renderWith(scene, m, 40, 11);
     CHECK(std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)) == 0);
     CHECK(a.alpha == b.alpha);

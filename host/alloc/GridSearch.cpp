@@ -24,9 +24,15 @@ static_assert(MA_GRID_MAX_TECHNIQUES == kMaxTechniques);
 
 namespace {
 
-// Weight combinations summed per pass over the samples: 4 · 2M float16 accumulators
-// for M = 2 and 2 · 2M for M ≥ 3 keep them, the sample and the α in 32 registers.
-int gridChunk(int techniqueCount) { return techniqueCount == 2 ? 4 : 2; }
+// B, the float16s of weight combinations that share one pass over a pixel's samples
+// and one division per sample (MA_BATCH_QUOTIENTS): 2B accumulator chains, and the
+// 160 combinations of the default grid in two passes.
+constexpr int kGridVectors = 5;
+constexpr int kPass = 16 * kGridVectors;
+
+// Work-items per group. PoCL keeps every work-item's private arrays of a group at
+// once; with the group size left to it (thousands) they overflow its stack.
+constexpr int kLocalSize = 16;
 
 void checkTechniqueCount(int techniqueCount) {
     if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
@@ -73,102 +79,98 @@ int closestResolution(int techniqueCount, int approximateSize) {
     return above - approximateSize <= approximateSize - below ? r + 1 : r;
 }
 
-std::vector<float> toFloats(const std::vector<double>& values) { return std::vector<float>(values.begin(), values.end()); }
-
-// What the kernel's summarise() finds for one pixel, by the same float operations.
-struct PixelSummary {
-    float count[kMaxTechniques] = {}, maxF[kMaxTechniques] = {};
-    float scale = 1.0f;
-    int invalid = 0;
+// The grid as the passes read it: α_{k,l} at [k · paddedSize + l], the size rounded up
+// to whole passes with copies of the last combination, which never win a tie.
+struct LaneGrid {
+    int paddedSize;
+    std::vector<float> alpha;
 };
 
-PixelSummary summarisePixel(const float* samples, const StoredSampleLayout& layout, int pixel) {
-    const int m = layout.techniqueCount;
-    auto at = [&](int i, int q) { return samples[kern::storedSampleIndex(pixel, i, q, layout.capacity, m)]; };
-    PixelSummary s;
-    float maxRatio = 0.0f;
-    for (int i = 0; i < layout.taken; ++i) {
-        float technique = at(i, 0), f = at(i, 1), pSum = at(i, 2);
-        for (int k = 1; k < m; ++k) pSum += at(i, 2 + k);
-        s.invalid |= !(f >= 0.0f && f <= FLT_MAX) || (f > 0.0f && pSum == 0.0f);
-        for (int k = 0; k < m; ++k) s.invalid |= !(at(i, 2 + k) >= 0.0f && at(i, 2 + k) <= FLT_MAX);
-        maxRatio = std::max(maxRatio, f / (pSum == 0.0f ? 1.0f : pSum));
-        int j = static_cast<int>(technique);
-        if (!(technique >= 0.0f && technique < m && j == technique)) {
-            s.invalid = 1;
-            continue;
-        }
-        s.count[j] += 1.0f;
-        s.maxF[j] = std::max(s.maxF[j], f);
-    }
-    s.scale = maxRatio == 0.0f ? 1.0f : 1.0f / maxRatio;
-    return s;
+LaneGrid laneGrid(const WeightGrid& grid) {
+    const int m = grid.techniqueCount, u = grid.size();
+    LaneGrid lanes{(u + kPass - 1) / kPass * kPass, {}};
+    lanes.alpha.resize(std::size_t(m) * lanes.paddedSize);
+    for (int k = 0; k < m; ++k)
+        for (int l = 0; l < lanes.paddedSize; ++l) lanes.alpha[k * lanes.paddedSize + l] = grid.alpha[std::min(l, u - 1) * m + k];
+    return lanes;
 }
 
-// The inputs of one search, shared by every pixel.
+std::vector<float> toFloats(const std::vector<double>& values) { return std::vector<float>(values.begin(), values.end()); }
+
+int kernelRule(GridRule rule) { return rule == GridRule::MaxEntropy ? MA_RULE_MAX_ENTROPY : MA_RULE_MIN_COST_VARIANCE; }
+
+// The inputs of one reference search, shared by every pixel.
 struct SearchSetup {
     const float* samples;
     StoredSampleLayout layout;
     WeightGrid grid;
-    std::vector<float> alphaByTechnique;  // [k·U + l]: the innermost loop runs over l
-    std::vector<float> cost;              // c_k
+    LaneGrid lanes;
+    std::vector<float> cost;  // c_k
     int rule;
 };
 
-// Σ g and Σ g² over each technique's samples for every l, g = scale · f / p_α
-// (000 Alg. 1 line 8). A sample with f = 0 adds nothing. M is a template argument so
-// that the loop over l is the only loop left to vectorise.
+// Σ g and Σ g² over each technique's samples for every combination l, at
+// [j · paddedSize + l] (000 Alg. 1 line 8): the kernel's sumTechnique as plain loops,
+// with the same operations in the same order. A sample with f = 0 adds nothing.
 template <int M>
-void sumPixel(const SearchSetup& setup, int pixel, float scale, std::vector<float>& sumG, std::vector<float>& sumG2) {
-    const int u = setup.grid.size();
-    std::fill(sumG.begin(), sumG.end(), 0.0f);
-    std::fill(sumG2.begin(), sumG2.end(), 0.0f);
-    auto at = [&](int i, int q) { return setup.samples[kern::storedSampleIndex(pixel, i, q, setup.layout.capacity, M)]; };
-    const float* alpha = setup.alphaByTechnique.data();
+void sumPixel(const SearchSetup& setup, const float* pixelSamples, float scale, float* sumG, float* sumG2) {
+    const int padded = setup.lanes.paddedSize;
+    const float* alpha = setup.lanes.alpha.data();
+    std::fill(sumG, sumG + M * padded, 0.0f);
+    std::fill(sumG2, sumG2 + M * padded, 0.0f);
     for (int i = 0; i < setup.layout.taken; ++i) {
-        float fs = at(i, 1) * scale;
-        if (fs == 0.0f) continue;
-        float pdf[M];
-        for (int k = 0; k < M; ++k) pdf[k] = at(i, 2 + k);
-        float* g1 = sumG.data() + static_cast<int>(at(i, 0)) * u;
-        float* g2 = sumG2.data() + static_cast<int>(at(i, 0)) * u;
+        kern::ScaledSample x = kern::scaledSample(pixelSamples, M, i, scale);
+        if (x.f == 0.0f) continue;
+        float* s = sumG + x.technique * padded;
+        float* s2 = sumG2 + x.technique * padded;
+        for (int l0 = 0; l0 < padded; l0 += kPass) {
 #pragma omp simd
-        for (int l = 0; l < u; ++l) {
-            float p = alpha[l] * pdf[0];
-            for (int k = 1; k < M; ++k) p = std::fma(alpha[k * u + l], pdf[k], p);
-            float g = fs / p;
-            g1[l] += g;
-            g2[l] = std::fma(g, g, g2[l]);
+            for (int lane = 0; lane < 16; ++lane) {
+                float p[kGridVectors], g[kGridVectors];
+                for (int c = 0; c < kGridVectors; ++c) {
+                    int l = l0 + 16 * c + lane;
+                    p[c] = alpha[l] * x.q[0];
+                    for (int k = 1; k < M; ++k) p[c] = std::fma(alpha[k * padded + l], x.q[k], p[c]);
+                }
+                MA_BATCH_QUOTIENTS(float, kGridVectors, x.f, p, g);
+                for (int c = 0; c < kGridVectors; ++c) {
+                    int l = l0 + 16 * c + lane;
+                    s[l] += g[c];
+                    s2[l] = std::fma(g[c], g[c], s2[l]);
+                }
+            }
         }
     }
 }
 
-void sumPixel(const SearchSetup& setup, int pixel, float scale, std::vector<float>& sumG, std::vector<float>& sumG2) {
+void sumPixel(const SearchSetup& setup, const float* pixelSamples, float scale, float* sumG, float* sumG2) {
     switch (setup.layout.techniqueCount) {
-        case 2: return sumPixel<2>(setup, pixel, scale, sumG, sumG2);
-        case 3: return sumPixel<3>(setup, pixel, scale, sumG, sumG2);
-        default: return sumPixel<4>(setup, pixel, scale, sumG, sumG2);
+        case 2: return sumPixel<2>(setup, pixelSamples, scale, sumG, sumG2);
+        case 3: return sumPixel<3>(setup, pixelSamples, scale, sumG, sumG2);
+        default: return sumPixel<4>(setup, pixelSamples, scale, sumG, sumG2);
     }
 }
 
-// 000 Alg. 1 lines 5–13 for one pixel.
+// 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it.
 void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& sumG, std::vector<float>& sumG2,
                  Allocation& allocation, int& selected) {
-    const int m = setup.layout.techniqueCount, u = setup.grid.size();
-    PixelSummary summary = summarisePixel(setup.samples, setup.layout, pixel);
-    unsigned fallbacks = kern::pixelFallbacks(m, summary.count, summary.maxF, summary.invalid);
+    const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
+    const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
+    kern::PixelSummary summary = kern::summarisePixel(pixelSamples, m, setup.layout.taken);
+    unsigned fallbacks = kern::pixelFallbacks(m, summary);
     int best = -1;
     if (fallbacks == 0) {
-        sumPixel(setup, pixel, summary.scale, sumG, sumG2);
-        float bestScore = -INFINITY;
-        for (int l = 0; l < u; ++l) {
+        sumPixel(setup, pixelSamples, summary.scale, sumG.data(), sumG2.data());
+        float invCount[kMaxTechniques], bestScore = -INFINITY;
+        for (int j = 0; j < m; ++j) invCount[j] = 1.0f / summary.count[j];
+        for (int l = 0; l < setup.grid.size(); ++l) {
             float g1[kMaxTechniques], g2[kMaxTechniques];
             for (int j = 0; j < m; ++j) {
-                g1[j] = sumG[j * u + l];
-                g2[j] = sumG2[j * u + l];
+                g1[j] = sumG[j * padded + l];
+                g2[j] = sumG2[j * padded + l];
             }
             float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l],
-                                          setup.cost.data(), g1, g2, summary.count);
+                                          setup.cost.data(), g1, g2, invCount);
             if (score > bestScore) {
                 bestScore = score;
                 best = l;
@@ -178,14 +180,9 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& sumG, 
             fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
     }
     selected = fallbacks == 0 ? best : -1;
-    if (fallbacks != 0) {
-        allocation = equalFallback(m, fallbacks);
-        return;
-    }
-    allocation = Allocation{std::vector<double>(&setup.grid.alpha[best * m], &setup.grid.alpha[best * m] + m)};
+    allocation = fallbacks != 0 ? equalFallback(m, fallbacks)
+                                : Allocation{std::vector<double>(&setup.grid.alpha[best * m], &setup.grid.alpha[best * m] + m)};
 }
-
-int kernelRule(GridRule rule) { return rule == GridRule::MaxEntropy ? MA_RULE_MAX_ENTROPY : MA_RULE_MIN_COST_VARIANCE; }
 
 }  // namespace
 
@@ -218,8 +215,8 @@ int GridSearchResult::fallbackCount() const {
 GridSearch::GridSearch(const Device& device, int techniqueCount) : device_(device), techniqueCount_(techniqueCount) {
     checkTechniqueCount(techniqueCount);
     cl::Program program = buildProgram(device, "gridsearch.cl",
-                                       fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_CHUNK={} {}",
-                                                   techniqueCount, std::getenv("GS_CHUNK") ? std::atoi(std::getenv("GS_CHUNK")) : gridChunk(techniqueCount), std::getenv("GS_OPTS") ? std::getenv("GS_OPTS") : ""));
+                                       fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={} {}",
+                                                   techniqueCount, kGridVectors, std::getenv("GS_OPTS") ? std::getenv("GS_OPTS") : ""));
     kernel_ = cl::Kernel(program, "gridSearch");
 }
 
@@ -234,7 +231,8 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
         return cl::Buffer(device_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(float),
                           data.data());
     };
-    cl::Buffer gridAlpha = upload(grid.alpha), gridCost = upload(grid.cost), cost = upload(toFloats(costs));
+    LaneGrid lanes = laneGrid(grid);
+    cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(grid.cost), cost = upload(toFloats(costs));
     cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
     cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
     cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
@@ -243,16 +241,17 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     kernel_.setArg(a++, cl_int(layout.capacity));
     kernel_.setArg(a++, cl_int(layout.taken));
     kernel_.setArg(a++, cl_int(pixels));
-    kernel_.setArg(a++, gridAlpha);
+    kernel_.setArg(a++, gridLanes);
     kernel_.setArg(a++, gridCost);
     kernel_.setArg(a++, cl_int(grid.size()));
+    kernel_.setArg(a++, cl_int(lanes.paddedSize));
     kernel_.setArg(a++, cost);
     kernel_.setArg(a++, cl_int(kernelRule(rule)));
     kernel_.setArg(a++, alphaOut);
     kernel_.setArg(a++, selectedOut);
     kernel_.setArg(a++, fallbacksOut);
     cl::Event done;
-    device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange((pixels + 15) / 16), cl::NullRange, nullptr,
+    device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange((pixels + kLocalSize - 1) / kLocalSize * kLocalSize), cl::NDRange(kLocalSize), nullptr,
                                        &done);
     done.wait();
     result.seconds = double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
@@ -278,12 +277,9 @@ GridSearchResult gridSearchReference(const std::vector<float>& samples, const St
                                      const std::vector<double>& costs, int gridSize, GridRule rule) {
     checkTechniqueCount(layout.techniqueCount);
     checkLayout(layout, layout.techniqueCount, samples.size());
-    SearchSetup setup{samples.data(), layout, makeWeightGrid(layout.techniqueCount, gridSize, costs), {},
-                      toFloats(costs), kernelRule(rule)};
-    const int m = layout.techniqueCount, u = setup.grid.size();
-    setup.alphaByTechnique.resize(std::size_t(m) * u);
-    for (int l = 0; l < u; ++l)
-        for (int k = 0; k < m; ++k) setup.alphaByTechnique[k * u + l] = setup.grid.alpha[l * m + k];
+    WeightGrid grid = makeWeightGrid(layout.techniqueCount, gridSize, costs);
+    SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
+    const std::size_t sums = std::size_t(layout.techniqueCount) * setup.lanes.paddedSize;
 
     GridSearchResult result;
     result.allocations.resize(layout.pixelCount);
@@ -291,7 +287,7 @@ GridSearchResult gridSearchReference(const std::vector<float>& samples, const St
     auto start = std::chrono::steady_clock::now();
 #pragma omp parallel
     {
-        std::vector<float> sumG(std::size_t(m) * u), sumG2(std::size_t(m) * u);  // [j·U + l]
+        std::vector<float> sumG(sums), sumG2(sums);
 #pragma omp for schedule(dynamic, 16)
         for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
             searchPixel(setup, pixel, sumG, sumG2, result.allocations[pixel], result.selected[pixel]);

@@ -22,6 +22,8 @@ constexpr MethodName kMethods[] = {
     {Method::Heuristic, "heuristic"},
     {Method::SigmaSqrtC, "sigma-sqrt-c"},
     {Method::Linear, "linear"},
+    {Method::Exact, "exact"},
+    {Method::Oracle, "oracle"},
 };
 
 std::string availableMethods() {
@@ -35,8 +37,6 @@ std::string availableMethods() {
 Method parseMethod(const std::string& name) {
   for (const auto& m : kMethods)
     if (name == m.name) return m.method;
-  if (name == "oracle" || name == "exact")
-    throw InputError(fmt::format("--method {}: not implemented yet (available: {})", name, availableMethods()));
   throw InputError(fmt::format("unknown --method '{}' (available: {})", name, availableMethods()));
 }
 
@@ -71,7 +71,9 @@ unsigned methodStatistics(Method method) {
   }
 }
 
-bool methodStoresSamples(Method method) { return method == Method::Linear || method == Method::Exact; }
+bool methodStoresSamples(Method method) {
+  return method == Method::Linear || method == Method::Exact || method == Method::Oracle;
+}
 
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel) {
   const int M = scene.techniqueCount();

@@ -8,10 +8,12 @@
 namespace misalloc {
 
 // How a pixel's N samples are split among the techniques. The first three are fixed
-// splits taken in one stage; the others allocate adaptively in batches (render/Adaptive.h).
-enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact };
+// splits taken in one stage; heuristic, sigma-sqrt-c, linear and exact allocate
+// adaptively in batches; oracle (evaluation only) takes the α that a high-sample
+// probe finds best (render/Render.h).
+enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle };
 
-// Throws InputError for an unknown name, or one that is not implemented (oracle).
+// Throws InputError for an unknown name.
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);
 std::vector<Method> allMethods();

@@ -83,14 +83,6 @@ std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techn
   return sizes;
 }
 
-SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp) {
-  SamplerConfig config;
-  config.estimator = isAdaptive(method) ? methodEstimator(method) : fixedSplitEstimator;
-  config.statsMask = methodStatistics(method);
-  config.sampleCapacity = methodStoresSamples(method) ? spp : 0;
-  return config;
-}
-
 double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator) {
   const int M = plan.techniqueCount;
   const double N = plan.stageSamples;
@@ -111,70 +103,147 @@ double stageVariance(const StagePlan& plan, const StageResult& result, int pixel
   return v;
 }
 
+namespace {
+
+// Everything a render has sampled so far.
+struct Progress {
+  StageTotals totals;
+  std::vector<int> taken;  // [pixel·M + k]: samples technique k took
+  int samplesBefore = 0;
+  std::vector<unsigned char> fellBack, floored;  // per pixel: a defensive rule was used
+};
+
+// Runs one stage with the given counts and adds it, weighted N_b/N, to the estimate.
+void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples, int spp,
+               uint64_t seed) {
+  const int M = sampler.scene().techniqueCount();
+  StagePlan plan;
+  plan.techniqueCount = M;
+  plan.stageSamples = stageSamples;
+  plan.samplesBefore = progress.samplesBefore;
+  plan.counts = std::move(counts);
+  plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
+  StageResult stage = sampler.run(plan, seed);
+  // Stage b's estimate is unbiased given the earlier stages, whatever its counts;
+  // weights N_b/N fixed in advance keep the combination unbiased.
+  accumulateStage(progress.totals, plan, stage, sampler.config().estimator, double(stageSamples) / spp);
+  for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += plan.counts[i];
+  progress.samplesBefore += stageSamples;
+}
+
+// Every pixel's weights from all its samples so far.
+std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
+                                            int taken) {
+  if (method == Method::Exact)
+    return sampler.searchWeights(options.costs, options.gridSize, options.gridRule, taken).allocations;
+  const int pixels = sampler.scene().pixelCount(), M = sampler.scene().techniqueCount(), slots = sampler.statSlots();
+  std::vector<double> stats = sampler.statistics();
+  std::vector<float> stored = methodStoresSamples(method) ? sampler.storedSamples() : std::vector<float>{};
+  std::vector<Allocation> allocations(pixels);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (int p = 0; p < pixels; ++p) {
+    PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, sampler.config().statsMask, M);
+    std::optional<PixelSamples> samples;
+    if (!stored.empty()) samples = decodePixelSamples(stored, p, taken, sampler.config().sampleCapacity, M);
+    allocations[p] = allocatePixel(method, options, pixelStats, samples ? &*samples : nullptr);
+  }
+  return allocations;
+}
+
+// The next stage's counts: cumulative counts approach α·T after it (000 Alg. 1 line 15).
+// `cumulative` false: the stage alone is split by α (the oracle's single stage).
+std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocation>& allocations, int stageSamples,
+                                 bool floor, bool cumulative = true) {
+  const int M = int(progress.taken.size() / progress.fellBack.size());
+  std::vector<int32_t> out(progress.taken.size());
+  for (size_t p = 0; p < allocations.size(); ++p) {
+    std::vector<int> taken(progress.taken.begin() + p * M, progress.taken.begin() + (p + 1) * M);
+    std::vector<int> counts =
+        cumulative ? nextStageCounts(taken, allocations[p].alpha, progress.samplesBefore + stageSamples)
+                   : apportionCounts(allocations[p].alpha, stageSamples);
+    progress.fellBack[p] |= allocations[p].usedFallback() ? 1 : 0;
+    if (floor) progress.floored[p] |= floorCounts(counts) ? 1 : 0;
+    std::copy(counts.begin(), counts.end(), out.begin() + p * M);
+  }
+  return out;
+}
+
+// The pilot: every pixel splits its first stage equally.
+std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
+  std::vector<int> counts = apportionCounts(std::vector<double>(M, 1.0), stageSamples);
+  std::vector<int32_t> out;
+  out.reserve(size_t(pixels) * M);
+  for (int p = 0; p < pixels; ++p) out.insert(out.end(), counts.begin(), counts.end());
+  return out;
+}
+
+}  // namespace
+
+SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options) {
+  SamplerConfig config;
+  config.estimator = isAdaptive(method) ? methodEstimator(method) : fixedSplitEstimator;
+  config.statsMask = methodStatistics(method);
+  config.sampleCapacity = methodStoresSamples(method) ? spp : 0;
+  if (method == Method::Oracle) config.sampleCapacity = options.oracleSamples + spp;
+  return config;
+}
+
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed) {
   auto start = Clock::now();
   const Scene& scene = sampler.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
-  const Estimator estimator = sampler.config().estimator;
+  // Stages need every technique where one alone does not cover the integrand (floorCounts).
+  const bool floor = sampler.config().estimator == Estimator::CountIndependent || M > 2;
   Rendering out;
-  StageTotals totals{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)};
-  std::vector<int> taken(size_t(pixels) * M, 0);
-
+  Progress progress{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
+                    std::vector<int>(size_t(pixels) * M, 0),
+                    0,
+                    std::vector<unsigned char>(pixels, 0),
+                    std::vector<unsigned char>(pixels, 0)};
   if (!isAdaptive(method)) {
-    StagePlan plan = singleStagePlan(scene, method, spp);
-    accumulateStage(totals, plan, sampler.run(plan, seed), estimator, 1.0);
-    taken.assign(plan.counts.begin(), plan.counts.end());
+    takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, spp, seed);
+  } else if (method == Method::Oracle) {
+    validateCosts(options.costs, M);
+    // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
+    // seed of its own, stands in for the true variance as a function of α; the render
+    // then takes the α it finds best in one stage.
+    auto probeStart = Clock::now();
+    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples,
+              options.oracleSamples, ~seed);
+    std::vector<Allocation> best =
+        sampler.searchWeights(options.costs, options.gridSize, GridRule::MinCostVariance, options.oracleSamples)
+            .allocations;
+    out.allocationSeconds = secondsSince(probeStart);
+    Progress render{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
+                    std::vector<int>(size_t(pixels) * M, 0),
+                    progress.samplesBefore,
+                    std::vector<unsigned char>(pixels, 0),
+                    std::vector<unsigned char>(pixels, 0)};
+    takeStage(sampler, render, stageCounts(render, best, spp, floor, false), spp, spp, seed);
+    progress = std::move(render);
   } else {
     validateCosts(options.costs, M);
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
-    std::vector<unsigned char> fellBack(pixels, 0), floored(pixels, 0);
-    int samplesBefore = 0;
-    for (size_t b = 0; b < sizes.size(); ++b) {
-      StagePlan plan;
-      plan.techniqueCount = M;
-      plan.stageSamples = sizes[b];
-      plan.samplesBefore = samplesBefore;
-      plan.counts.resize(size_t(pixels) * M);
-      plan.firstIndex.assign(taken.begin(), taken.end());
+    takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], spp, seed);
+    for (size_t b = 1; b < sizes.size(); ++b) {
       auto allocationStart = Clock::now();
-      std::vector<double> stats = b > 0 ? sampler.statistics() : std::vector<double>{};
-      std::vector<float> stored = b > 0 && methodStoresSamples(method) ? sampler.storedSamples() : std::vector<float>{};
-      const int slots = sampler.statSlots();
-#pragma omp parallel for schedule(dynamic, 256)
-      for (int p = 0; p < pixels; ++p) {
-        std::vector<int> pixelTaken(taken.begin() + size_t(p) * M, taken.begin() + size_t(p + 1) * M);
-        std::vector<int> counts;
-        if (b == 0) {
-          counts = apportionCounts(std::vector<double>(M, 1.0), sizes[0]);
-        } else {
-          PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, sampler.config().statsMask, M);
-          std::optional<PixelSamples> samples;
-          if (!stored.empty())
-            samples = decodePixelSamples(stored, p, samplesBefore, sampler.config().sampleCapacity, M);
-          Allocation a = allocatePixel(method, options, pixelStats, samples ? &*samples : nullptr);
-          fellBack[p] |= a.usedFallback() ? 1 : 0;
-          counts = nextStageCounts(pixelTaken, a.alpha, samplesBefore + sizes[b]);
-        }
-        if (estimator == Estimator::CountIndependent || M > 2) floored[p] |= floorCounts(counts) ? 1 : 0;
-        std::copy(counts.begin(), counts.end(), plan.counts.begin() + size_t(p) * M);
-      }
+      std::vector<Allocation> allocations = allocateFromSamples(sampler, method, options, progress.samplesBefore);
+      std::vector<int32_t> counts = stageCounts(progress, allocations, sizes[b], floor);
       out.allocationSeconds += secondsSince(allocationStart);
-      StageResult stage = sampler.run(plan, seed);
-      // Stage b's estimate is unbiased given the earlier stages, whatever its counts;
-      // weights N_b/N fixed in advance keep the combination unbiased.
-      accumulateStage(totals, plan, stage, estimator, double(sizes[b]) / spp);
-      for (size_t i = 0; i < taken.size(); ++i) taken[i] += plan.counts[i];
-      samplesBefore += sizes[b];
+      takeStage(sampler, progress, std::move(counts), sizes[b], spp, seed);
     }
-    out.fallbackPixels = size_t(std::count(fellBack.begin(), fellBack.end(), 1));
-    out.flooredPixels = size_t(std::count(floored.begin(), floored.end(), 1));
   }
-  out.image = RgbImage{scene.grid.width, scene.grid.height, std::vector<float>(totals.rgb.begin(), totals.rgb.end())};
-  out.variance = std::move(totals.variance);
-  out.alpha.resize(taken.size());
-  for (size_t i = 0; i < taken.size(); ++i) out.alpha[i] = double(taken[i]) / spp;
-  out.kernelSeconds = totals.kernelSeconds;
+  out.fallbackPixels = size_t(std::count(progress.fellBack.begin(), progress.fellBack.end(), 1));
+  out.flooredPixels = size_t(std::count(progress.floored.begin(), progress.floored.end(), 1));
+  out.image = RgbImage{scene.grid.width, scene.grid.height,
+                       std::vector<float>(progress.totals.rgb.begin(), progress.totals.rgb.end())};
+  out.variance = std::move(progress.totals.variance);
+  out.alpha.resize(progress.taken.size());
+  for (size_t i = 0; i < progress.taken.size(); ++i) out.alpha[i] = double(progress.taken[i]) / spp;
+  out.statisticsBytesPerPixel =
+      double(sampler.statSlots()) * sizeof(double) + double(sampler.storedSampleCount()) * sizeof(float) / pixels;
+  out.kernelSeconds = progress.totals.kernelSeconds;
   out.wallSeconds = secondsSince(start);
   out.hostSeconds = std::max(0.0, out.wallSeconds - out.kernelSeconds - out.allocationSeconds);
   return out;

@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "alloc/GridSearch.h"
 #include "alloc/LinearAllocation.h"
 #include "render/Method.h"
 #include "render/Sampler.h"
@@ -15,6 +16,9 @@ struct AdaptiveOptions {
   int stages = 4;              // after the pilot
   std::vector<double> costs;   // c_k per sample, one per technique
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
+  int gridSize = kDefaultGridSize;  // exact: U weight combinations
+  GridRule gridRule = GridRule::MinCostVariance;
+  int oracleSamples = 1024;  // oracle: equal-count probe samples per pixel
 };
 
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError
@@ -28,6 +32,7 @@ struct Rendering {
   size_t fallbackPixels = 0;     // pixels where an allocation rule fell back (alloc/Allocation.h)
   size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
   int stageCount = 1;
+  double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
   double kernelSeconds = 0;      // device time of the sampling kernels (profiling events)
   double allocationSeconds = 0;  // reading statistics back and allocating
   double hostSeconds = 0;        // everything else: planning, transfers, reductions
@@ -39,7 +44,7 @@ struct Rendering {
 // (samplerConfigFor).
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
 
-SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp);
+SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);
 
 // Estimated variance of a pixel's stage estimate from the per-technique moments of
 // its luminance values w. Balance heuristic, multi-sample: Σ_k n_k s_k² / N² (002 eq. 21

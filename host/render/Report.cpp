@@ -24,6 +24,7 @@ nlohmann::json sceneJson(const Scene& scene) {
           {"envmap_file", scene.envmapPath},
           {"envmap_size", {scene.tables.width, scene.tables.height}},
           {"envmap_uniform_fallback", scene.tables.uniformFallback},
+          {"envmap_negative_values_zeroed", scene.envmapWarnings.negativeValues},
           {"grid", o.grid},
           {"size", {o.width, o.height}},
           {"view_deg", {o.viewTheta, o.viewPhi}},
@@ -59,6 +60,7 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"samples_per_second", double(pixels) * run.spp / r.kernelSeconds},
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
       {"mean_alpha", meanAlpha},
+      {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
   };
   if (isAdaptive(run.method)) {
     nlohmann::json costs;

@@ -38,6 +38,10 @@ size_t StageSampler::storedSampleCount() const {
   return paddedPixels * size_t(config_.sampleCapacity) * size_t(scene_.techniqueCount() + 2);
 }
 
+StoredSampleLayout StageSampler::storedSampleLayout(int taken) const {
+  return {scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken};
+}
+
 std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
   const int M = scene.techniqueCount();
   std::vector<float> samples((size_t(scene.pixelCount()) + 15) / 16 * 16 * size_t(capacity) * size_t(M + 2), 1.0f);
@@ -143,6 +147,11 @@ std::vector<double> Sampler::statistics() {
   const size_t n = size_t(scene_.pixelCount()) * statSlots();
   if (n == 0) return {};
   return doubleSums_ ? readSums<double>(device_, stats_, n) : readSums<float>(device_, stats_, n);
+}
+
+GridSearchResult Sampler::searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) {
+  if (!gridSearch_) gridSearch_ = std::make_unique<GridSearch>(device_, scene_.techniqueCount());
+  return gridSearch_->run(samples_, storedSampleLayout(taken), costs, gridSize, rule);
 }
 
 std::vector<float> Sampler::storedSamples() {

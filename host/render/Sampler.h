@@ -1,9 +1,11 @@
 #pragma once
 #include <CL/opencl.hpp>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "alloc/GridSearch.h"
 #include "cl/Device.h"
 #include "render/Scene.h"
 #include "render/Stage.h"
@@ -22,11 +24,16 @@ class StageSampler {
   // samples in the layout of kernels/stats.h's storedSampleIndex.
   virtual std::vector<double> statistics() = 0;
   virtual std::vector<float> storedSamples() = 0;
+  // 000 Algorithm 1 over the first `taken` stored samples of every pixel
+  // (kernels/gridsearch.cl on a device, its C++ reference on the host).
+  virtual GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule,
+                                         int taken) = 0;
 
   const Scene& scene() const { return scene_; }
   const SamplerConfig& config() const { return config_; }
   int statSlots() const;             // running sums per pixel
   size_t storedSampleCount() const;  // floats in the stored-samples buffer
+  StoredSampleLayout storedSampleLayout(int taken) const;
 
  protected:
   const Scene& scene_;
@@ -45,11 +52,11 @@ class Sampler : public StageSampler {
   StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
-  const cl::Buffer& storedSamplesBuffer() const { return samples_; }
-  const Device& device() const { return device_; }
+  GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) override;
 
  private:
   const Device& device_;
+  std::unique_ptr<GridSearch> gridSearch_;  // built at the first search
   int localSize_;
   bool doubleSums_;
   cl::Kernel kernel_;
@@ -64,6 +71,9 @@ class HostSampler : public StageSampler {
   StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override { return stats_; }
   std::vector<float> storedSamples() override { return samples_; }
+  GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) override {
+    return gridSearchReference(samples_, storedSampleLayout(taken), costs, gridSize, rule);
+  }
 
  private:
   std::vector<double> stats_;

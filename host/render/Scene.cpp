@@ -46,7 +46,7 @@ Scene makeScene(const SceneOptions& options) {
   scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
-  scene.envmap = makeEnvmap(resolved, options.proceduralWidth);
+  scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
   scene.tables = buildEnvmapTables(scene.envmap, options.sampler);
   double t = options.viewTheta * M_PI / 180, p = options.viewPhi * M_PI / 180;
   // ω_r = 2(n·ω_o)n − ω_o with n = z.

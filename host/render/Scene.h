@@ -27,6 +27,7 @@ struct Scene {
   EnvmapTables tables;
   BrdfGrid grid;
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
+  ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
 
   int techniqueCount() const { return options.splitBrdf ? 3 : 2; }
   int pixelCount() const { return grid.width * grid.height; }
