@@ -34,42 +34,52 @@ MA_FN float inversePowerOfTwo(float x) {
   return ma_as_float((ma_uint)(254 - e) << 23);
 }
 
-// What decides whether a pixel can be searched (pixelFallbacks), and the scale of g.
+// What decides whether a pixel can be searched (pixelFallbacks), gathered one sample at
+// a time (summariseSample): the kernel interleaves 16 pixels' samples, so that it
+// reads every cache line of the blocked layout once.
 typedef struct {
   float count[MA_GRID_MAX_TECHNIQUES];  // m_j
-  float maxF[MA_GRID_MAX_TECHNIQUES];   // the largest f of technique j; 0: silent
-  // 1 / max_i f_i / Σ_k p_k(x_i). Since p_α ≥ (min_k α_k) Σ_k p_k, every scaled
-  // g = scale · f / p_α is at most 1 / min_k α_k: float sums cannot overflow.
-  float scale;
+  int nonZero[MA_GRID_MAX_TECHNIQUES];  // technique j's samples with f > 0; 0: silent
+  float maxRatio;                       // max_i f_i / Σ_k p_k(x_i)
   int invalid;  // a NaN, infinite or negative f or pdf, f > 0 where every pdf is 0,
                 // or a technique index outside 0 … M−1
 } PixelSummary;
 
-MA_FN PixelSummary summarisePixel(MA_GLOBAL const float* pixelSamples, int techniqueCount, int taken) {
+MA_FN PixelSummary emptySummary(void) {
   PixelSummary s;
-  for (int j = 0; j < MA_GRID_MAX_TECHNIQUES; ++j) s.count[j] = s.maxF[j] = 0.0f;
-  s.invalid = 0;
-  float maxRatio = 0.0f;
-  for (int i = 0; i < taken; ++i) {
-    float technique = storedValue(pixelSamples, techniqueCount, i, 0);
-    float f = storedValue(pixelSamples, techniqueCount, i, 1), pSum = 0.0f;
-    for (int k = 0; k < techniqueCount; ++k) {
-      float p = storedValue(pixelSamples, techniqueCount, i, 2 + k);
-      s.invalid |= !(p >= 0.0f && p <= FLT_MAX);
-      pSum += p;
-    }
-    int j = technique >= 0.0f && technique < (float)techniqueCount ? (int)technique : -1;
-    if (!(f >= 0.0f && f <= FLT_MAX) || (f > 0.0f && pSum == 0.0f) || j < 0 || (float)j != technique) {
-      s.invalid = 1;
-      continue;
-    }
-    maxRatio = ma_max(maxRatio, pSum > 0.0f ? f / pSum : 0.0f);
-    s.count[j] += 1.0f;
-    s.maxF[j] = ma_max(s.maxF[j], f);
+  for (int j = 0; j < MA_GRID_MAX_TECHNIQUES; ++j) {
+    s.count[j] = 0.0f;
+    s.nonZero[j] = 0;
   }
-  s.scale = maxRatio > 0.0f ? 1.0f / maxRatio : 1.0f;
+  s.maxRatio = 0.0f;
+  s.invalid = 0;
   return s;
 }
+
+MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples, int techniqueCount, int i) {
+  float technique = storedValue(pixelSamples, techniqueCount, i, 0);
+  float f = storedValue(pixelSamples, techniqueCount, i, 1), pSum = 0.0f;
+  int invalid = !(f >= 0.0f && f <= FLT_MAX), drawn = 0;
+  MA_UNROLL
+  for (int k = 0; k < techniqueCount; ++k) {
+    float p = storedValue(pixelSamples, techniqueCount, i, 2 + k);
+    invalid |= !(p >= 0.0f && p <= FLT_MAX);
+    pSum += p;
+  }
+  MA_UNROLL
+  for (int j = 0; j < techniqueCount; ++j) {
+    int t = technique == (float)j;
+    drawn |= t;
+    s->count[j] += t ? 1.0f : 0.0f;
+    s->nonZero[j] += t && f > 0.0f;
+  }
+  s->invalid |= invalid || !drawn || (f > 0.0f && pSum == 0.0f);
+  s->maxRatio = ma_max(s->maxRatio, pSum > 0.0f ? f / pSum : 0.0f);
+}
+
+// The scale of g: since p_α ≥ (min_k α_k) Σ_k p_k, every scaled g = scale · f / p_α
+// is at most 1 / min_k α_k, so float sums of g² cannot overflow.
+MA_FN float sampleScale(PixelSummary s) { return s.maxRatio > 0.0f ? 1.0f / s.maxRatio : 1.0f; }
 
 // Why a pixel cannot be searched; every reason gives equal weights. A variance
 // estimate needs m_j ≥ 2. A technique whose samples all have f = 0 has μ_j = ν_j = 0:
@@ -81,38 +91,45 @@ MA_FN ma_uint pixelFallbacks(int techniqueCount, PixelSummary s) {
   int signal = 0;
   for (int j = 0; j < techniqueCount; ++j) {
     bits |= s.count[j] < 2.0f ? MA_FALLBACK_TOO_FEW_SAMPLES : 0u;
-    signal |= s.maxF[j] > 0.0f;
+    signal |= s.nonZero[j] > 0;
   }
   if (bits != 0) return bits;
   if (!signal) return MA_FALLBACK_NO_SIGNAL;
-  for (int j = 0; j < techniqueCount; ++j) bits |= s.maxF[j] > 0.0f ? 0u : MA_FALLBACK_SILENT_TECHNIQUE;
+  for (int j = 0; j < techniqueCount; ++j) bits |= s.nonZero[j] > 0 ? 0u : MA_FALLBACK_SILENT_TECHNIQUE;
   return bits;
 }
 
-// Sample i as the grid loop uses it: f and the pdfs multiplied by the same power of
-// two, so that Σ_k q_k ∈ [1, 2) and p_α ∈ [min α, 2): a product of a few p_α neither
-// overflows nor underflows (MA_BATCH_QUOTIENTS). f also takes the pixel's scale.
-// Where every pdf is 0, f = 0 too (else the pixel fell back); q_0 = 1 then keeps
-// p_α > 0, so that g = 0 rather than 0/0.
-typedef struct {
-  int technique;
-  float f;
-  float q[MA_GRID_MAX_TECHNIQUES];
-} ScaledSample;
+// The sums need only the samples with f > 0 (the others add 0), and read them grouped
+// by technique, so that the loop over one technique's samples runs without tests:
+// technique j's start after those of the techniques before it.
+MA_FN int preparedFirst(PixelSummary s, int j) {
+  int first = 0;
+  for (int k = 0; k < j; ++k) first += s.nonZero[k];
+  return first;
+}
 
-MA_FN ScaledSample scaledSample(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, float scale) {
-  ScaledSample s;
-  s.technique = (int)storedValue(pixelSamples, techniqueCount, i, 0);
-  float pSum = 0.0f;
+// Copies sample i, if f > 0, to slot next[j]++ of `prepared` (M + 1 floats a slot,
+// next[j] starting at preparedFirst): f · scale · 2^−e, then p_k · 2^−e for every k,
+// with 2^−e = inversePowerOfTwo(Σ_k p_k). The common power of two leaves every
+// g = f/p_α exactly as it was and puts p_α in [min α, 2), so that a product of a few
+// p_α neither overflows nor underflows (MA_BATCH_QUOTIENTS).
+MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, float scale, int* next,
+                         MA_GLOBAL float* prepared) {
+  float technique = storedValue(pixelSamples, techniqueCount, i, 0);
+  float f = storedValue(pixelSamples, techniqueCount, i, 1);
+  if (f == 0.0f) return;
+  int j = (int)technique;
+  MA_GLOBAL float* out = prepared + (next[j]++) * (techniqueCount + 1);
+  float pdf[MA_GRID_MAX_TECHNIQUES], pSum = 0.0f;
+  MA_UNROLL
   for (int k = 0; k < techniqueCount; ++k) {
-    s.q[k] = storedValue(pixelSamples, techniqueCount, i, 2 + k);
-    pSum += s.q[k];
+    pdf[k] = storedValue(pixelSamples, techniqueCount, i, 2 + k);
+    pSum += pdf[k];
   }
   float normalise = inversePowerOfTwo(pSum);
-  for (int k = 0; k < techniqueCount; ++k) s.q[k] *= normalise;
-  s.q[0] = pSum > 0.0f ? s.q[0] : 1.0f;
-  s.f = storedValue(pixelSamples, techniqueCount, i, 1) * scale * normalise;
-  return s;
+  out[0] = f * scale * normalise;
+  MA_UNROLL
+  for (int k = 0; k < techniqueCount; ++k) out[1 + k] = pdf[k] * normalise;
 }
 
 // r_c = numerator / x_c for c < count with one division (Montgomery's batch

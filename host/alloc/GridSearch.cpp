@@ -32,7 +32,7 @@ constexpr int kPass = 16 * kGridVectors;
 
 // Work-items per group. PoCL keeps every work-item's private arrays of a group at
 // once; with the group size left to it (thousands) they overflow its stack.
-constexpr int kLocalSize = 16;
+constexpr int kLocalSize = 4;
 
 void checkTechniqueCount(int techniqueCount) {
     if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
@@ -111,63 +111,75 @@ struct SearchSetup {
 
 // Σ g and Σ g² over each technique's samples for every combination l, at
 // [j · paddedSize + l] (000 Alg. 1 line 8): the kernel's sumTechnique as plain loops,
-// with the same operations in the same order. A sample with f = 0 adds nothing.
+// with the same operations in the same order.
 template <int M>
-void sumPixel(const SearchSetup& setup, const float* pixelSamples, float scale, float* sumG, float* sumG2) {
+void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
+              float* sumG2) {
     const int padded = setup.lanes.paddedSize;
     const float* alpha = setup.lanes.alpha.data();
-    std::fill(sumG, sumG + M * padded, 0.0f);
-    std::fill(sumG2, sumG2 + M * padded, 0.0f);
-    for (int i = 0; i < setup.layout.taken; ++i) {
-        kern::ScaledSample x = kern::scaledSample(pixelSamples, M, i, scale);
-        if (x.f == 0.0f) continue;
-        float* s = sumG + x.technique * padded;
-        float* s2 = sumG2 + x.technique * padded;
-        for (int l0 = 0; l0 < padded; l0 += kPass) {
+    for (int j = 0; j < M; ++j) {
+        float* s = sumG + j * padded;
+        float* s2 = sumG2 + j * padded;
+        std::fill(s, s + padded, 0.0f);
+        std::fill(s2, s2 + padded, 0.0f);
+        const float* x = prepared + kern::preparedFirst(summary, j) * (M + 1);
+        for (int i = 0; i < summary.nonZero[j]; ++i, x += M + 1) {
+            for (int l0 = 0; l0 < padded; l0 += kPass) {
 #pragma omp simd
-            for (int lane = 0; lane < 16; ++lane) {
-                float p[kGridVectors], g[kGridVectors];
-                for (int c = 0; c < kGridVectors; ++c) {
-                    int l = l0 + 16 * c + lane;
-                    p[c] = alpha[l] * x.q[0];
-                    for (int k = 1; k < M; ++k) p[c] = std::fma(alpha[k * padded + l], x.q[k], p[c]);
-                }
-                MA_BATCH_QUOTIENTS(float, kGridVectors, x.f, p, g);
-                for (int c = 0; c < kGridVectors; ++c) {
-                    int l = l0 + 16 * c + lane;
-                    s[l] += g[c];
-                    s2[l] = std::fma(g[c], g[c], s2[l]);
+                for (int lane = 0; lane < 16; ++lane) {
+                    float p[kGridVectors], g[kGridVectors];
+                    for (int v = 0; v < kGridVectors; ++v) {
+                        int l = l0 + 16 * v + lane;
+                        p[v] = alpha[l] * x[1];
+                        for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
+                    }
+                    MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
+                    for (int v = 0; v < kGridVectors; ++v) {
+                        int l = l0 + 16 * v + lane;
+                        s[l] += g[v];
+                        s2[l] = std::fma(g[v], g[v], s2[l]);
+                    }
                 }
             }
         }
     }
 }
 
-void sumPixel(const SearchSetup& setup, const float* pixelSamples, float scale, float* sumG, float* sumG2) {
+void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
+              float* sumG2) {
     switch (setup.layout.techniqueCount) {
-        case 2: return sumPixel<2>(setup, pixelSamples, scale, sumG, sumG2);
-        case 3: return sumPixel<3>(setup, pixelSamples, scale, sumG, sumG2);
-        default: return sumPixel<4>(setup, pixelSamples, scale, sumG, sumG2);
+        case 2: return sumPixel<2>(setup, summary, prepared, sumG, sumG2);
+        case 3: return sumPixel<3>(setup, summary, prepared, sumG, sumG2);
+        default: return sumPixel<4>(setup, summary, prepared, sumG, sumG2);
     }
 }
 
+// Per-thread buffers of the reference.
+struct Scratch {
+    std::vector<float> prepared, sumG, sumG2;
+};
+
 // 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it.
-void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& sumG, std::vector<float>& sumG2,
-                 Allocation& allocation, int& selected) {
+void searchPixel(const SearchSetup& setup, int pixel, Scratch& scratch, Allocation& allocation, int& selected) {
     const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
     const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
-    kern::PixelSummary summary = kern::summarisePixel(pixelSamples, m, setup.layout.taken);
+    kern::PixelSummary summary = kern::emptySummary();
+    for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&summary, pixelSamples, m, i);
     unsigned fallbacks = kern::pixelFallbacks(m, summary);
     int best = -1;
     if (fallbacks == 0) {
-        sumPixel(setup, pixelSamples, summary.scale, sumG.data(), sumG2.data());
+        int next[kMaxTechniques];
+        for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(summary, j);
+        for (int i = 0; i < setup.layout.taken; ++i)
+            kern::prepareSample(pixelSamples, m, i, kern::sampleScale(summary), next, scratch.prepared.data());
+        sumPixel(setup, summary, scratch.prepared.data(), scratch.sumG.data(), scratch.sumG2.data());
         float invCount[kMaxTechniques], bestScore = -INFINITY;
         for (int j = 0; j < m; ++j) invCount[j] = 1.0f / summary.count[j];
         for (int l = 0; l < setup.grid.size(); ++l) {
             float g1[kMaxTechniques], g2[kMaxTechniques];
             for (int j = 0; j < m; ++j) {
-                g1[j] = sumG[j * padded + l];
-                g2[j] = sumG2[j * padded + l];
+                g1[j] = scratch.sumG[j * padded + l];
+                g2[j] = scratch.sumG2[j * padded + l];
             }
             float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l],
                                           setup.cost.data(), g1, g2, invCount);
@@ -233,6 +245,9 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     };
     LaneGrid lanes = laneGrid(grid);
     cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(grid.cost), cost = upload(toFloats(costs));
+    // At least one float: a zero-size buffer is invalid.
+    cl::Buffer prepared(device_.context, CL_MEM_READ_WRITE,
+                        std::max<std::size_t>(1, (std::size_t(pixels) + 15) / 16 * 16 * layout.taken * (m + 1)) * sizeof(float));
     cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
     cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
     cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
@@ -247,11 +262,13 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     kernel_.setArg(a++, cl_int(lanes.paddedSize));
     kernel_.setArg(a++, cost);
     kernel_.setArg(a++, cl_int(kernelRule(rule)));
+    kernel_.setArg(a++, prepared);
     kernel_.setArg(a++, alphaOut);
     kernel_.setArg(a++, selectedOut);
     kernel_.setArg(a++, fallbacksOut);
     cl::Event done;
-    device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange((pixels + kLocalSize - 1) / kLocalSize * kLocalSize), cl::NDRange(kLocalSize), nullptr,
+    const int blocks = (pixels + 15) / 16;
+    device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange((blocks + kLocalSize - 1) / kLocalSize * kLocalSize), cl::NDRange(kLocalSize), nullptr,
                                        &done);
     done.wait();
     result.seconds = double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
@@ -287,10 +304,11 @@ GridSearchResult gridSearchReference(const std::vector<float>& samples, const St
     auto start = std::chrono::steady_clock::now();
 #pragma omp parallel
     {
-        std::vector<float> sumG(sums), sumG2(sums);
+        Scratch scratch{std::vector<float>(std::size_t(layout.taken) * (layout.techniqueCount + 1)),
+                        std::vector<float>(sums), std::vector<float>(sums)};
 #pragma omp for schedule(dynamic, 16)
         for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
-            searchPixel(setup, pixel, sumG, sumG2, result.allocations[pixel], result.selected[pixel]);
+            searchPixel(setup, pixel, scratch, result.allocations[pixel], result.selected[pixel]);
     }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
