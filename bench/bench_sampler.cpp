@@ -10,9 +10,9 @@
 
 #include <cstring>
 #include <iostream>
-#include <map>
 #include <memory>
 
+#include "PeerComparison.h"
 #include "cl/Device.h"
 #include "render/Method.h"
 #include "render/Sampler.h"
@@ -73,22 +73,11 @@ void benchOpenMp(benchmark::State& state, const Variant& v) {
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 
-// Keeps the median samples/s of every benchmark for the closing table.
-class MedianCollector : public benchmark::ConsoleReporter {
- public:
-  std::map<std::string, double> medians;
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs)
-      if (r.aggregate_name == "median") medians[r.run_name.function_name] = r.counters.at("samples/s").value;
-    ConsoleReporter::ReportRuns(runs);
-  }
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest;
-  for (int i = 0; i < argc; ++i) {
+  std::vector<char*> rest{argv[0]};
+  for (int i = 1; i < argc; ++i) {
     auto value = [&](const char* flag) { return std::strcmp(argv[i], flag) == 0 && i + 1 < argc; };
     if (value("--device"))
       config.device = argv[++i];
@@ -99,30 +88,17 @@ int main(int argc, char** argv) {
     else
       rest.push_back(argv[i]);
   }
-  int restCount = int(rest.size());
-  benchmark::Initialize(&restCount, rest.data());
+  bench::initialize(rest);
+  std::vector<std::string> names;
   for (const Variant& v : kVariants) {
-    for (const char* impl : {"opencl", "openmp"}) {
-      auto fn = std::string(impl) == "opencl" ? benchOpenCl : benchOpenMp;
-      benchmark::RegisterBenchmark(fmt::format("{}/{}", impl, v.name).c_str(),
-                                   [fn, &v](benchmark::State& s) { fn(s, v); })
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime()
-          ->MinTime(0.5)
-          ->Repetitions(5)
-          ->ReportAggregatesOnly(true);
-    }
+    names.push_back(v.name);
+    bench::registerPeers(
+        v.name, [&v](benchmark::State& s) { benchOpenCl(s, v); }, [&v](benchmark::State& s) { benchOpenMp(s, v); });
   }
-  MedianCollector reporter;
+  bench::MedianCollector reporter("samples/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
   std::cout << fmt::format("\nSampling, {}x{} pixels, {} spp, OpenCL device: {}\n\n", config.size, config.size,
                            config.spp, device().name())
-            << "| technique | OpenCL Msample/s | OpenMP Msample/s | ratio |\n|---|---|---|---|\n";
-  for (const Variant& v : kVariants) {
-    auto cl = reporter.medians.find("opencl/" + v.name), mp = reporter.medians.find("openmp/" + v.name);
-    if (cl == reporter.medians.end() || mp == reporter.medians.end()) continue;
-    std::cout << fmt::format("| {} | {:.1f} | {:.1f} | {:.2f} |\n", v.name, cl->second * 1e-6, mp->second * 1e-6,
-                             cl->second / mp->second);
-  }
+            << bench::ratioTable(reporter, names, "technique", "Msample/s", 1e6);
   benchmark::Shutdown();
 }

@@ -191,7 +191,8 @@ int main(int argc, char** argv) {
         checkWritableOutput(alphaPngPath(alphaMap), "--alpha-map");
       }
       Scene scene = renderScene.make();
-      if (isAdaptive(m)) stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
+      if (isAdaptive(m) && m != Method::Oracle)
+        stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
       std::string costSource = "--cost";
       if (!costList.empty()) adaptive.costs = parseCosts(costList, scene.techniqueCount());
       std::unique_ptr<Device> device;

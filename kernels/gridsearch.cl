@@ -18,11 +18,11 @@
 
 #define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
 
-// Σ g and Σ g² over technique j's n prepared samples (prepareSamples) for the
+// Σ g and Σ g² over technique j's n prepared samples (prepareSample) for the
 // combinations l0 … l0 + MA_PASS − 1 (000 Alg. 1 line 8; eq. 6.6 and 6.8 before dividing
 // by m_j). alpha[v][k] holds α_k of the 16 combinations of vector v.
 MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
-                        float* sumG, float* sumG2) {
+                        float16* sumG, float16* sumG2) {
   float16 s[MA_GRID_VECTORS], s2[MA_GRID_VECTORS];
   MA_UNROLL
   for (int v = 0; v < MA_GRID_VECTORS; ++v) s[v] = s2[v] = 0.0f;
@@ -44,53 +44,102 @@ MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alp
   }
   MA_UNROLL
   for (int v = 0; v < MA_GRID_VECTORS; ++v) {
-    vstore16(s[v], v, sumG);
-    vstore16(s2[v], v, sumG2);
+    sumG[v] = s[v];
+    sumG2[v] = s2[v];
   }
 }
 
+// The best of 16 candidates (score, index) per lane: the highest score, ties to the
+// lowest index, as a scan in index order would keep it. NaN scores never win, nor do
+// the copies that pad the grid: they share a batch of quotients with other
+// combinations than the original, so their sums can differ in the last bits.
+typedef struct {
+  float16 score;
+  int16 index;
+} LaneBest;
+
+MA_FN void keepBetter(LaneBest* best, float16 score, int16 index, int gridSize) {
+  int16 better = score > best->score && index < gridSize;
+  best->score = select(best->score, score, better);
+  best->index = select(best->index, index, better);
+}
+
+MA_FN int bestIndex(LaneBest best) {
+  float score[16];
+  int index[16];
+  vstore16(best.score, 0, score);
+  vstore16(best.index, 0, index);
+  int l = -1;
+  float top = -INFINITY;
+  for (int lane = 0; lane < 16; ++lane) {
+    if (score[lane] > top || (score[lane] == top && index[lane] < l)) {
+      top = score[lane];
+      l = index[lane];
+    }
+  }
+  return l;
+}
+
 // 000 Alg. 1 lines 5–13 for one pixel whose prepared samples are at `prepared`.
-// Returns l₀, or −1 if no combination could be ranked.
+// Returns l₀, or −1 if no combination could be ranked. Rule (b) scores 16 combinations
+// per float16; rule (a) takes its logarithms one combination at a time.
 MA_FN int searchPixel(__global const float* prepared, PixelSummary summary, __global const float* gridLanes,
                       __global const float* gridCost, int gridSize, int paddedSize, const float* cost, int rule) {
   float invCount[MA_TECHNIQUES];
   for (int j = 0; j < MA_TECHNIQUES; ++j) invCount[j] = 1.0f / summary.count[j];
-  float bestScore = -INFINITY;
-  int best = -1;
+  const int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  LaneBest best = {(float16)(-INFINITY), (int16)(-1)};
   for (int l0 = 0; l0 < gridSize; l0 += MA_PASS) {
     float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES];
     for (int v = 0; v < MA_GRID_VECTORS; ++v)
       for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[v][k] = vload16(0, gridLanes + k * paddedSize + l0 + 16 * v);
-    float sumG[MA_TECHNIQUES][MA_PASS], sumG2[MA_TECHNIQUES][MA_PASS];
+    float16 sumG[MA_TECHNIQUES][MA_GRID_VECTORS], sumG2[MA_TECHNIQUES][MA_GRID_VECTORS];
     for (int j = 0; j < MA_TECHNIQUES; ++j)
       sumTechnique(prepared + preparedFirst(summary, j) * (MA_TECHNIQUES + 1), summary.nonZero[j], alpha, sumG[j],
                    sumG2[j]);
-    for (int n = 0; n < MA_PASS && l0 + n < gridSize; ++n) {
-      float a[MA_TECHNIQUES], g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
+    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+      float16 g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
       for (int j = 0; j < MA_TECHNIQUES; ++j) {
-        a[j] = gridLanes[j * paddedSize + l0 + n];
-        g1[j] = sumG[j][n];
-        g2[j] = sumG2[j][n];
+        g1[j] = sumG[j][v];
+        g2[j] = sumG2[j][v];
       }
-      float score = gridScore(rule, MA_TECHNIQUES, a, gridCost[l0 + n], cost, g1, g2, invCount);
-      if (score > bestScore) {
-        bestScore = score;
-        best = l0 + n;
+      int16 index = l0 + 16 * v + lanes;
+      float16 score;
+      if (rule == MA_RULE_MAX_ENTROPY) {
+        float a[16][MA_TECHNIQUES], s1[MA_TECHNIQUES][16], s2[MA_TECHNIQUES][16], h[16];
+        for (int j = 0; j < MA_TECHNIQUES; ++j) {
+          vstore16(g1[j], 0, s1[j]);
+          vstore16(g2[j], 0, s2[j]);
+        }
+        for (int lane = 0; lane < 16; ++lane) {
+          float sumLane[MA_TECHNIQUES], sum2Lane[MA_TECHNIQUES];
+          for (int j = 0; j < MA_TECHNIQUES; ++j) {
+            a[lane][j] = gridLanes[j * paddedSize + l0 + 16 * v + lane];
+            sumLane[j] = s1[j][lane];
+            sum2Lane[j] = s2[j][lane];
+          }
+          h[lane] =
+              entropyScore(MA_TECHNIQUES, a[lane], gridCost[l0 + 16 * v + lane], cost, sumLane, sum2Lane, invCount);
+        }
+        score = vload16(0, h);
+      } else {
+        score = costVarianceScore16(MA_TECHNIQUES, alpha[v], vload16(0, gridCost + l0 + 16 * v), g1, g2, invCount);
       }
+      keepBetter(&best, score, index, gridSize);
     }
   }
-  return best;
+  return bestIndex(best);
 }
 
-// One work-item per block of 16 pixels. gridLanes[k · paddedSize + l] = α_{k,l}
-// (padded past gridSize with the last combination), gridCost[l] = Σ_k c_k α_{k,l},
+// One work-item per block of 16 pixels. gridLanes[k · paddedSize + l] = α_{k,l} and
+// gridCost[l] = Σ_k c_k α_{k,l}, both padded past gridSize with the last combination;
 // cost[k] = c_k; `prepared` has taken · (M + 1) floats per pixel (prepareSample).
 // Outputs per pixel: α (M floats), the selected index l₀ (−1 where the pixel fell
 // back to equal weights) and AllocationFallback bits.
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
-                         __global const float* gridLanes, __global const float* gridCost, int gridSize,
-                         int paddedSize, __global const float* cost, int rule, __global float* prepared,
-                         __global float* alphaOut, __global int* selectedOut, __global uint* fallbacksOut) {
+                         __global const float* gridLanes, __global const float* gridCost, int gridSize, int paddedSize,
+                         __global const float* cost, int rule, __global float* prepared, __global float* alphaOut,
+                         __global int* selectedOut, __global uint* fallbacksOut) {
   int block = (int)get_global_id(0);
   if (16 * block >= pixelCount) return;
   __global const float* blockSamples = samples + (size_t)block * capacity * (MA_TECHNIQUES + 2) * 16;
@@ -123,10 +172,12 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
                          gridSize, paddedSize, c, rule);
       // No combination could be ranked: non-finite sums, or for rule (a) no λ that
       // is a distribution (eq. 4.16 has no solution on the grid).
-      if (best < 0) fallbacks[lane] = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
+      if (best < 0)
+        fallbacks[lane] = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
     }
     for (int k = 0; k < MA_TECHNIQUES; ++k)
-      alphaOut[pixel * MA_TECHNIQUES + k] = fallbacks[lane] == 0u ? gridLanes[k * paddedSize + best] : 1.0f / MA_TECHNIQUES;
+      alphaOut[pixel * MA_TECHNIQUES + k] =
+          fallbacks[lane] == 0u ? gridLanes[k * paddedSize + best] : 1.0f / MA_TECHNIQUES;
     selectedOut[pixel] = fallbacks[lane] == 0u ? best : -1;
     fallbacksOut[pixel] = fallbacks[lane];
   }

@@ -41,8 +41,9 @@ typedef struct {
   float count[MA_GRID_MAX_TECHNIQUES];  // m_j
   int nonZero[MA_GRID_MAX_TECHNIQUES];  // technique j's samples with f > 0; 0: silent
   float maxRatio;                       // max_i f_i / Σ_k p_k(x_i)
-  int invalid;  // a NaN, infinite or negative f or pdf, f > 0 where every pdf is 0,
-                // or a technique index outside 0 … M−1
+  // A NaN, infinite or negative f or pdf, f > 0 where every pdf is 0, or a technique
+  // index outside 0 … M−1.
+  int invalid;
 } PixelSummary;
 
 MA_FN PixelSummary emptySummary(void) {
@@ -136,43 +137,50 @@ MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount
 // inversion): prefix products P_c = x_0 ⋯ x_c, then q = numerator / P_{count−1} and,
 // walking back, r_c = q · P_{c−1}, q ← q · x_c, r_0 = q. Each r_c carries about
 // count + 1 roundings instead of one. A macro so that the kernel (T = float16) and the
-// reference (T = float) run the same operations in the same order.
-#define MA_BATCH_QUOTIENTS(T, count, numerator, x, r)                                 \
-  do {                                                                                \
-    T prefix_[count];                                                                 \
-    prefix_[0] = (x)[0];                                                              \
-    MA_UNROLL for (int c_ = 1; c_ < (count); ++c_) prefix_[c_] = prefix_[c_ - 1] * (x)[c_]; \
-    T q_ = (numerator) / prefix_[(count) - 1];                                        \
-    MA_UNROLL for (int c_ = (count) - 1; c_ > 0; --c_) {                              \
-      (r)[c_] = q_ * prefix_[c_ - 1];                                                 \
-      q_ = q_ * (x)[c_];                                                              \
-    }                                                                                 \
-    (r)[0] = q_;                                                                      \
+// reference (T = float) run the same operations in the same order; count is a constant.
+#define MA_BATCH_QUOTIENTS(T, count, numerator, x, r)                                     \
+  do {                                                                                    \
+    T prefix_[count];                                                                     \
+    prefix_[0] = (x)[0];                                                                  \
+    MA_UNROLL for (int c_ = 1; c_ < count; ++c_) prefix_[c_] = prefix_[c_ - 1] * (x)[c_]; \
+    T q_ = (numerator) / prefix_[count - 1];                                              \
+    MA_UNROLL for (int c_ = count - 1; c_ > 0; --c_) {                                    \
+      (r)[c_] = q_ * prefix_[c_ - 1];                                                     \
+      q_ = q_ * (x)[c_];                                                                  \
+    }                                                                                     \
+    (r)[0] = q_;                                                                          \
   } while (0)
 
 // Rule (b): −(Σ_k c_k α_k) V, with V the variance of the multi-sample balance heuristic
-// for N = 1 (002 eq. 21 and Table 2): V = ∫ f²/p_α − Σ_j μ'_j²/α_j with
+// for N = 1 (002 eq. 21 and Table 2; ../shared/papers/README.md, "Multi-sample"), the
+// estimator the renderer runs with the selected α: V = ∫ f²/p_α − Σ_j μ'_j²/α_j with
 // μ'_j = ∫ α_j p_j f / p_α = α_j μ_j, and ∫ f²/p_α = Σ_j α_j ν_j, so V = Σ_j α_j (ν_j − μ_j²),
 // μ_j = E_j[g] and ν_j = E_j[g²] under technique j's pdf, g = f/p_α. They are estimated
 // from technique j's m_j samples by 000 eq. 6.6 and 6.8. Cancellation can leave a
 // tiny negative ν_j − μ_j², which is 0.
-MA_FN float costVarianceScore(int techniqueCount, const float* alpha, float meanCost, const float* sumG,
-                              const float* sumG2, const float* invCount) {
-  float variance = 0.0f;
-  for (int j = 0; j < techniqueCount; ++j) {
-    float mu = sumG[j] * invCount[j], nu = sumG2[j] * invCount[j];
-    variance = ma_fma(alpha[j], ma_max(ma_fma(-mu, mu, nu), 0.0f), variance);
+// Defined for T = float and, in the kernel, T = float16 (16 combinations at once):
+// OpenCL C has no overloading, and the builtins in the body take either.
+#define MA_DEFINE_COST_VARIANCE_SCORE(name, T)                                                                         \
+  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const T* sumG, const T* sumG2, const float* invCount) { \
+    T variance = 0.0f;                                                                                                 \
+    for (int j = 0; j < techniqueCount; ++j) {                                                                         \
+      T mu = sumG[j] * invCount[j], nu = sumG2[j] * invCount[j];                                                       \
+      variance = ma_fma(alpha[j], ma_max(ma_fma(-mu, mu, nu), 0.0f), variance);                                        \
+    }                                                                                                                  \
+    return -(meanCost * variance);                                                                                     \
   }
-  return -(meanCost * variance);
-}
+MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore, float)
+#ifdef __OPENCL_VERSION__
+MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore16, float16)
+#endif
 
 // Rule (a), 000 Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
 // V = Σ_j α_j ν_j − μ² (000 eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j (000 eq. 4.16)
 // is the same for every j at the optimum. Score: the entropy of λ_j = Λ_j / Σ_j Λ_j.
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.
-MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost, const float* cost,
-                         const float* sumG, const float* sumG2, const float* invCount) {
+MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost, const float* cost, const float* sumG,
+                         const float* sumG2, const float* invCount) {
   float mu = 0.0f, secondMoment = 0.0f;
   for (int j = 0; j < techniqueCount; ++j) {
     mu = ma_fma(alpha[j], sumG[j] * invCount[j], mu);

@@ -1,9 +1,9 @@
 // The exact allocation (000 Algorithm 1): kernels/gridsearch.cl on PoCL against its C++
 // reference, and both against optima known in closed form or by quadrature.
-#include <catch2/catch.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -22,56 +22,56 @@ using namespace misalloc::test;
 namespace {
 
 struct Sample {
-    int technique;
-    float f;
-    std::vector<float> pdf;
+  int technique;
+  float f;
+  std::vector<float> pdf;
 };
 using PixelSampleList = std::vector<Sample>;
 
 // The pixels' samples in the blocked layout of kernels/stats.h; padding lanes hold
 // technique 0, f = 0 and pdfs 1, as kernels/sample.cl leaves them.
 std::vector<float> store(const std::vector<PixelSampleList>& pixels, const StoredSampleLayout& layout) {
-    const int m = layout.techniqueCount;
-    std::vector<float> samples(layout.floatCount(), 1.0f);
-    const int paddedPixels = (layout.pixelCount + 15) / 16 * 16;
-    for (int pixel = 0; pixel < paddedPixels; ++pixel)
-        for (int i = 0; i < layout.taken; ++i) {
-            auto at = [&](int q) -> float& { return samples[kern::storedSampleIndex(pixel, i, q, layout.capacity, m)]; };
-            if (pixel >= layout.pixelCount) {
-                at(0) = at(1) = 0.0f;
-                continue;
-            }
-            const Sample& s = pixels[pixel][i];
-            at(0) = float(s.technique);
-            at(1) = s.f;
-            for (int k = 0; k < m; ++k) at(2 + k) = s.pdf[k];
-        }
-    return samples;
+  const int m = layout.techniqueCount;
+  std::vector<float> samples(layout.floatCount(), 1.0f);
+  const int paddedPixels = (layout.pixelCount + 15) / 16 * 16;
+  for (int pixel = 0; pixel < paddedPixels; ++pixel)
+    for (int i = 0; i < layout.taken; ++i) {
+      auto at = [&](int q) -> float& { return samples[kern::storedSampleIndex(pixel, i, q, layout.capacity, m)]; };
+      if (pixel >= layout.pixelCount) {
+        at(0) = at(1) = 0.0f;
+        continue;
+      }
+      const Sample& s = pixels[pixel][i];
+      at(0) = float(s.technique);
+      at(1) = s.f;
+      for (int k = 0; k < m; ++k) at(2 + k) = s.pdf[k];
+    }
+  return samples;
 }
 
 StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, int techniqueCount, int capacity) {
-    return StoredSampleLayout{int(pixels.size()), techniqueCount, capacity, int(pixels.front().size())};
+  return StoredSampleLayout{int(pixels.size()), techniqueCount, capacity, int(pixels.front().size())};
 }
 
 GridSearch& deviceSearch(int techniqueCount) {
-    static std::map<int, std::unique_ptr<GridSearch>> searches;
-    auto& search = searches[techniqueCount];
-    if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount);
-    return *search;
+  static std::map<int, std::unique_ptr<GridSearch>> searches;
+  auto& search = searches[techniqueCount];
+  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount);
+  return *search;
 }
 
 struct BothResults {
-    GridSearchResult device, reference;
+  GridSearchResult device, reference;
 };
 
 BothResults searchBoth(const std::vector<PixelSampleList>& pixels, int techniqueCount, const std::vector<double>& costs,
                        GridRule rule, int gridSize = kDefaultGridSize, int capacity = 0) {
-    StoredSampleLayout layout = layoutOf(pixels, techniqueCount, std::max(capacity, int(pixels.front().size())));
-    std::vector<float> samples = store(pixels, layout);
-    cl::Buffer buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
-                      samples.data());
-    return {deviceSearch(techniqueCount).run(buffer, layout, costs, gridSize, rule),
-            gridSearchReference(samples, layout, costs, gridSize, rule)};
+  StoredSampleLayout layout = layoutOf(pixels, techniqueCount, std::max(capacity, int(pixels.front().size())));
+  std::vector<float> samples = store(pixels, layout);
+  cl::Buffer buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
+                    samples.data());
+  return {deviceSearch(techniqueCount).run(buffer, layout, costs, gridSize, rule),
+          gridSearchReference(samples, layout, costs, gridSize, rule)};
 }
 
 // Techniques on [0, 1] with pdfs p_0 = 1, p_1 = 2x, p_2 = 3x², sampled by inversion.
@@ -81,35 +81,35 @@ double sampleTechnique(int k, double u) { return std::pow(u, 1.0 / (k + 1)); }
 // n stratified samples per technique (u = (s + ½)/n), techniques interleaved: the
 // estimates of 000 eq. 6.6 and 6.8 then become midpoint quadratures, close to exact.
 PixelSampleList stratified(double (*f)(double), int techniqueCount, int n) {
-    PixelSampleList samples;
-    for (int s = 0; s < n; ++s)
-        for (int k = 0; k < techniqueCount; ++k) {
-            double x = sampleTechnique(k, (s + 0.5) / n);
-            Sample sample{k, float(f(x)), {}};
-            for (int l = 0; l < techniqueCount; ++l) sample.pdf.push_back(float(techniquePdf(l, x)));
-            samples.push_back(sample);
-        }
-    return samples;
+  PixelSampleList samples;
+  for (int s = 0; s < n; ++s)
+    for (int k = 0; k < techniqueCount; ++k) {
+      double x = sampleTechnique(k, (s + 0.5) / n);
+      Sample sample{k, float(f(x)), {}};
+      for (int l = 0; l < techniqueCount; ++l) sample.pdf.push_back(float(techniquePdf(l, x)));
+      samples.push_back(sample);
+    }
+  return samples;
 }
 
 // Random pixels: per pixel a random technique mixture, lognormal pdfs and values, and
 // a quarter of the values 0 (samples that miss the light).
 std::vector<PixelSampleList> randomPixels(int techniqueCount, int pixelCount, int taken, std::uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    std::normal_distribution<double> normal(0.0, 1.0);
-    std::vector<PixelSampleList> pixels(pixelCount);
-    for (auto& pixel : pixels) {
-        std::vector<double> mixture(techniqueCount);
-        for (double& w : mixture) w = 0.2 + uniform(rng);
-        std::discrete_distribution<int> choose(mixture.begin(), mixture.end());
-        for (int i = 0; i < taken; ++i) {
-            Sample s{choose(rng), uniform(rng) < 0.25 ? 0.0f : float(std::exp(normal(rng))), {}};
-            for (int k = 0; k < techniqueCount; ++k) s.pdf.push_back(float(std::exp(normal(rng))));
-            pixel.push_back(s);
-        }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<PixelSampleList> pixels(pixelCount);
+  for (auto& pixel : pixels) {
+    std::vector<double> mixture(techniqueCount);
+    for (double& w : mixture) w = 0.2 + uniform(rng);
+    std::discrete_distribution<int> choose(mixture.begin(), mixture.end());
+    for (int i = 0; i < taken; ++i) {
+      Sample s{choose(rng), uniform(rng) < 0.25 ? 0.0f : float(std::exp(normal(rng))), {}};
+      for (int k = 0; k < techniqueCount; ++k) s.pdf.push_back(float(std::exp(normal(rng))));
+      pixel.push_back(s);
     }
-    return pixels;
+  }
+  return pixels;
 }
 
 // The weight of technique k at the selected combination.
@@ -118,17 +118,17 @@ double selectedAlpha(const GridSearchResult& r, int k) { return r.allocations.fr
 // 002 Table 2 (README: "Multi-sample") by quadrature: V(α) = ∫ f²/p_α − Σ_j α_j μ_j²
 // with μ_j = ∫ f p_j / p_α, for N = 1.
 double multiSampleVariance(double (*f)(double), const float* alpha, int techniqueCount) {
-    auto mixture = [&](double x) {
-        double p = 0;
-        for (int k = 0; k < techniqueCount; ++k) p += alpha[k] * techniquePdf(k, x);
-        return p;
-    };
-    double variance = integrate([&](double x) { return f(x) * f(x) / mixture(x); }, 0, 1);
-    for (int j = 0; j < techniqueCount; ++j) {
-        double mu = integrate([&](double x) { return f(x) * techniquePdf(j, x) / mixture(x); }, 0, 1);
-        variance -= alpha[j] * mu * mu;
-    }
-    return variance;
+  auto mixture = [&](double x) {
+    double p = 0;
+    for (int k = 0; k < techniqueCount; ++k) p += alpha[k] * techniquePdf(k, x);
+    return p;
+  };
+  double variance = integrate([&](double x) { return f(x) * f(x) / mixture(x); }, 0, 1);
+  for (int j = 0; j < techniqueCount; ++j) {
+    double mu = integrate([&](double x) { return f(x) * techniquePdf(j, x) / mixture(x); }, 0, 1);
+    variance -= alpha[j] * mu * mu;
+  }
+  return variance;
 }
 
 double linear(double x) { return x; }
@@ -139,140 +139,161 @@ double sqrtPlus(double x) { return std::sqrt(x) + 0.2; }
 }  // namespace
 
 TEST_CASE("the weight grid covers the simplex's interior", "[exact]") {
-    WeightGrid two = makeWeightGrid(2, 160, {1.0, 3.0});
-    REQUIRE(two.size() == 160);
-    CHECK(two.alpha[0] == Approx(0.5 / 160));
-    CHECK(two.alpha[2 * 159] == Approx(159.5 / 160));
-    CHECK(two.cost[0] == Approx(0.5 / 160 + 3 * 159.5 / 160));
-    WeightGrid three = makeWeightGrid(3, 160, {1.0, 1.0, 1.0});
-    CHECK(three.size() == 153);  // r = 16: C(18, 2); r = 17 would give 171
-    for (int l = 0; l < three.size(); ++l) {
-        const float* a = &three.alpha[3 * l];
-        CHECK(a[0] + a[1] + a[2] == Approx(1.0));
-        CHECK(std::min({a[0], a[1], a[2]}) >= Approx(1.0 / 3 / 17));
-    }
-    CHECK_THROWS_AS(makeWeightGrid(1, 160, {1.0}), std::invalid_argument);
-    CHECK_THROWS_AS(makeWeightGrid(2, 160, {1.0, 0.0}), std::invalid_argument);
+  WeightGrid two = makeWeightGrid(2, 160, {1.0, 3.0});
+  REQUIRE(two.size() == 160);
+  CHECK(two.alpha[0] == Approx(0.5 / 160));
+  CHECK(two.alpha[2 * 159] == Approx(159.5 / 160));
+  CHECK(two.cost[0] == Approx(0.5 / 160 + 3 * 159.5 / 160));
+  WeightGrid three = makeWeightGrid(3, 160, {1.0, 1.0, 1.0});
+  CHECK(three.size() == 153);  // r = 16: C(18, 2); r = 17 would give 171
+  for (int l = 0; l < three.size(); ++l) {
+    const float* a = &three.alpha[3 * l];
+    CHECK(a[0] + a[1] + a[2] == Approx(1.0));
+    CHECK(std::min({a[0], a[1], a[2]}) >= Approx(1.0 / 3 / 17));
+  }
+  CHECK_THROWS_AS(makeWeightGrid(1, 160, {1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(makeWeightGrid(2, 160, {1.0, 0.0}), std::invalid_argument);
 }
 
 TEST_CASE("the kernel selects what the C++ reference selects on random samples", "[exact]") {
-    for (int m : {2, 3}) {
-        for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
-            const int pixels = 2003;  // not a multiple of 16: a partial last block
-            auto data = randomPixels(m, pixels, 40, 7 + m);
-            std::vector<double> costs = m == 2 ? std::vector<double>{1.0, 2.5} : std::vector<double>{1.0, 2.5, 0.7};
-            BothResults r = searchBoth(data, m, costs, rule, kDefaultGridSize, 48);
-            int same = 0;
-            for (int p = 0; p < pixels; ++p) {
-                if (r.device.selected[p] != r.reference.selected[p]) continue;
-                ++same;
-                CHECK(r.device.allocations[p].alpha == r.reference.allocations[p].alpha);
-                CHECK(r.device.allocations[p].fallbacks == r.reference.allocations[p].fallbacks);
-            }
-            INFO(fmt::format("M = {}, rule {}: {} of {} agree, {} fell back", m, int(rule), same, pixels,
-                             r.reference.fallbackCount()));
-            // The sums are bitwise equal (same float operations in the same order); the
-            // scores can differ by an ulp where the compilers fuse fastLog2's last
-            // multiply-add differently, which flips only near-exact ties.
-            CHECK(same >= 0.999 * pixels);
-            // Mostly too few samples of a technique; for rule (a) and M = 3 also ~20 % of
-            // pixels where no λ on the grid is a distribution.
-            CHECK(r.reference.fallbackCount() < pixels / 4);
-        }
+  for (int m : {2, 3}) {
+    for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
+      const int pixels = 2003;  // not a multiple of 16: a partial last block
+      auto data = randomPixels(m, pixels, 40, 7 + m);
+      std::vector<double> costs = m == 2 ? std::vector<double>{1.0, 2.5} : std::vector<double>{1.0, 2.5, 0.7};
+      BothResults r = searchBoth(data, m, costs, rule, kDefaultGridSize, 48);
+      int same = 0;
+      for (int p = 0; p < pixels; ++p) {
+        if (r.device.selected[p] != r.reference.selected[p]) continue;
+        ++same;
+        CHECK(r.device.allocations[p].alpha == r.reference.allocations[p].alpha);
+        CHECK(r.device.allocations[p].fallbacks == r.reference.allocations[p].fallbacks);
+      }
+      INFO(fmt::format("M = {}, rule {}: {} of {} agree, {} fell back", m, int(rule), same, pixels,
+                       r.reference.fallbackCount()));
+      // Neighbouring combinations often score within float noise of each other: a
+      // perturbation of 1–2 ulps in f flips ~0.5 % of the selections for M = 2. So the
+      // kernel and the reference run the same float operations in the same order
+      // (kernels/gridsearch.h), and agree bit for bit here. The 0.1 % allowed is for
+      // fastLog2 (rule (a)), whose last multiply-add a compiler may or may not fuse.
+      CHECK(same >= 0.999 * pixels);
+      // Mostly too few samples of a technique; for rule (a) and M = 3 also ~20 % of
+      // pixels where no λ on the grid is a distribution.
+      CHECK(r.reference.fallbackCount() < pixels / 4);
     }
+  }
 }
 
 TEST_CASE("a technique proportional to f takes the end of the grid", "[exact]") {
-    // p_1 = 2x ∝ f = x, p_0 = 1 ∝ f = 1, and p_2 = 3x² ∝ f = x²: the zero-variance
-    // weights are α = 1 for that technique, the lattice point nearest to it. Rule (a) is
-    // checked for M = 2 only: for M = 3 the entropy of λ is nearly flat along the
-    // directions that trade the active technique for a mixture of the other two (for
-    // f = x it prefers α = (0.02, 0.90, 0.08), whose variance is 1.8 times the corner's,
-    // and ranks α_1 = 0.49 with 40 times the variance almost as high).
-    struct Case {
-        int m;
-        double (*f)(double);
-        int technique;
-        std::vector<GridRule> rules;
-    };
-    const std::vector<GridRule> both{GridRule::MinCostVariance, GridRule::MaxEntropy};
-    for (const Case& c : {Case{2, linear, 1, both}, Case{2, constant, 0, both},
-                          Case{3, square, 2, {GridRule::MinCostVariance}},
-                          Case{3, linear, 1, {GridRule::MinCostVariance}}}) {
-        for (GridRule rule : c.rules) {
-            BothResults r = searchBoth({stratified(c.f, c.m, 100)}, c.m, std::vector<double>(c.m, 1.0), rule);
-            WeightGrid grid = makeWeightGrid(c.m, kDefaultGridSize, std::vector<double>(c.m, 1.0));
-            float largest = 0;
-            for (int l = 0; l < grid.size(); ++l) largest = std::max(largest, grid.alpha[l * c.m + c.technique]);
-            INFO(fmt::format("M = {}, technique {}, rule {}", c.m, c.technique, int(rule)));
-            for (const GridSearchResult* result : {&r.device, &r.reference}) {
-                REQUIRE(result->fallbackCount() == 0);
-                CHECK(selectedAlpha(*result, c.technique) == Approx(largest));
-            }
-        }
+  // p_1 = 2x ∝ f = x, p_0 = 1 ∝ f = 1, and p_2 = 3x² ∝ f = x²: the zero-variance
+  // weights are α = 1 for that technique, the lattice point nearest to it. Rule (a) is
+  // checked for M = 2 only: for M = 3 the entropy of λ is nearly flat along the
+  // directions that trade the active technique for a mixture of the other two (for
+  // f = x it prefers α = (0.02, 0.90, 0.08), whose variance is 1.8 times the corner's,
+  // and ranks α_1 = 0.49 with 40 times the variance almost as high).
+  struct Case {
+    int m;
+    double (*f)(double);
+    int technique;
+    std::vector<GridRule> rules;
+  };
+  const std::vector<GridRule> both{GridRule::MinCostVariance, GridRule::MaxEntropy};
+  for (const Case& c :
+       {Case{2, linear, 1, both}, Case{2, constant, 0, both}, Case{3, square, 2, {GridRule::MinCostVariance}},
+        Case{3, linear, 1, {GridRule::MinCostVariance}}}) {
+    for (GridRule rule : c.rules) {
+      BothResults r = searchBoth({stratified(c.f, c.m, 100)}, c.m, std::vector<double>(c.m, 1.0), rule);
+      WeightGrid grid = makeWeightGrid(c.m, kDefaultGridSize, std::vector<double>(c.m, 1.0));
+      float largest = 0;
+      for (int l = 0; l < grid.size(); ++l) largest = std::max(largest, grid.alpha[l * c.m + c.technique]);
+      INFO(fmt::format("M = {}, technique {}, rule {}", c.m, c.technique, int(rule)));
+      for (const GridSearchResult* result : {&r.device, &r.reference}) {
+        REQUIRE(result->fallbackCount() == 0);
+        CHECK(selectedAlpha(*result, c.technique) == Approx(largest));
+      }
     }
+  }
 }
 
 TEST_CASE("the minimum-variance rule finds the quadrature optimum of the variance", "[exact]") {
-    // f = √x + 0.2 with p_0 = 1, p_1 = 2x: the multi-sample variance has its minimum
-    // inside the grid, near α_0 = 0.52, and grows by 2–3 % three grid steps away.
-    const std::vector<double> costs{1.0, 1.0};
-    WeightGrid grid = makeWeightGrid(2, kDefaultGridSize, costs);
-    int exact = 0;
-    double least = std::numeric_limits<double>::infinity();
-    for (int l = 0; l < grid.size(); ++l) {
-        double v = grid.cost[l] * multiSampleVariance(sqrtPlus, &grid.alpha[2 * l], 2);
-        if (v < least) least = v, exact = l;
-    }
-    REQUIRE(exact > 10);
-    REQUIRE(exact < grid.size() - 10);
-    BothResults r = searchBoth({stratified(sqrtPlus, 2, 2000)}, 2, costs, GridRule::MinCostVariance);
-    INFO(fmt::format("quadrature optimum l = {}, kernel {}, reference {}", exact, r.device.selected[0],
-                     r.reference.selected[0]));
-    CHECK(std::abs(r.device.selected[0] - exact) <= 1);
-    CHECK(std::abs(r.reference.selected[0] - exact) <= 1);
+  // f = √x + 0.2 with p_0 = 1, p_1 = 2x: the multi-sample variance has its minimum
+  // inside the grid, near α_0 = 0.52, and grows by 2–3 % three grid steps away.
+  const std::vector<double> costs{1.0, 1.0};
+  WeightGrid grid = makeWeightGrid(2, kDefaultGridSize, costs);
+  int exact = 0;
+  double least = std::numeric_limits<double>::infinity();
+  for (int l = 0; l < grid.size(); ++l) {
+    double v = grid.cost[l] * multiSampleVariance(sqrtPlus, &grid.alpha[2 * l], 2);
+    if (v < least) least = v, exact = l;
+  }
+  REQUIRE(exact > 10);
+  REQUIRE(exact < grid.size() - 10);
+  BothResults r = searchBoth({stratified(sqrtPlus, 2, 2000)}, 2, costs, GridRule::MinCostVariance);
+  INFO(fmt::format("quadrature optimum l = {}, kernel {}, reference {}", exact, r.device.selected[0],
+                   r.reference.selected[0]));
+  CHECK(std::abs(r.device.selected[0] - exact) <= 1);
+  CHECK(std::abs(r.reference.selected[0] - exact) <= 1);
 }
 
 TEST_CASE("an expensive technique gets a smaller weight", "[exact]") {
-    // The same f as above; costing one technique 1000 times the other moves the optimum
-    // of cost × variance to the cheap technique's end of the grid.
-    for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
-        PixelSampleList samples = stratified(sqrtPlus, 2, 400);
-        BothResults equal = searchBoth({samples}, 2, {1.0, 1.0}, rule);
-        BothResults dearFirst = searchBoth({samples}, 2, {1000.0, 1.0}, rule);
-        BothResults dearSecond = searchBoth({samples}, 2, {1.0, 1000.0}, rule);
-        INFO(fmt::format("rule {}: α_0 = {} (equal costs), {} (c_0 = 1000), {} (c_1 = 1000)", int(rule),
-                         selectedAlpha(equal.device, 0), selectedAlpha(dearFirst.device, 0),
-                         selectedAlpha(dearSecond.device, 0)));
-        CHECK(selectedAlpha(dearFirst.device, 0) < selectedAlpha(equal.device, 0) - 0.2);
-        CHECK(selectedAlpha(dearSecond.device, 0) > selectedAlpha(equal.device, 0) + 0.2);
-        CHECK(dearFirst.device.selected == dearFirst.reference.selected);
-        CHECK(dearSecond.device.selected == dearSecond.reference.selected);
-    }
+  // The same f as above; costing one technique 1000 times the other moves the optimum
+  // of cost × variance to the cheap technique's end of the grid.
+  for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
+    PixelSampleList samples = stratified(sqrtPlus, 2, 400);
+    BothResults equal = searchBoth({samples}, 2, {1.0, 1.0}, rule);
+    BothResults dearFirst = searchBoth({samples}, 2, {1000.0, 1.0}, rule);
+    BothResults dearSecond = searchBoth({samples}, 2, {1.0, 1000.0}, rule);
+    INFO(fmt::format("rule {}: α_0 = {} (equal costs), {} (c_0 = 1000), {} (c_1 = 1000)", int(rule),
+                     selectedAlpha(equal.device, 0), selectedAlpha(dearFirst.device, 0),
+                     selectedAlpha(dearSecond.device, 0)));
+    CHECK(selectedAlpha(dearFirst.device, 0) < selectedAlpha(equal.device, 0) - 0.2);
+    CHECK(selectedAlpha(dearSecond.device, 0) > selectedAlpha(equal.device, 0) + 0.2);
+    CHECK(dearFirst.device.selected == dearFirst.reference.selected);
+    CHECK(dearSecond.device.selected == dearSecond.reference.selected);
+  }
 }
 
 TEST_CASE("pixels the grid cannot rank fall back to equal weights", "[exact]") {
-    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
-    PixelSampleList usable = stratified(sqrtPlus, 2, 10);
-    std::vector<PixelSampleList> pixels(6, usable);
-    for (Sample& s : pixels[1]) s.f = s.technique == 1 ? 0.0f : s.f;                 // technique 1 silent
-    for (Sample& s : pixels[2]) s.technique = &s == &pixels[2].front() ? 1 : 0;      // one sample of technique 1
-    pixels[3][5].f = nan;                                                            // non-finite value
-    for (Sample& s : pixels[4]) s.f = 0.0f;                                          // no signal at all
-    pixels[5][3].pdf[1] = inf;                                                       // non-finite pdf
-    const unsigned expected[] = {kFallbackNone, kFallbackSilentTechnique, kFallbackTooFewSamples, kFallbackNonFinite,
-                                 kFallbackNoSignal, kFallbackNonFinite};
-    for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
-        BothResults r = searchBoth(pixels, 2, {1.0, 1.0}, rule);
-        for (const GridSearchResult* result : {&r.device, &r.reference}) {
-            CHECK(result->fallbackCount() == 5);
-            for (int p = 0; p < 6; ++p) {
-                INFO(fmt::format("rule {}, pixel {}", int(rule), p));
-                CHECK(result->allocations[p].fallbacks == expected[p]);
-                if (p == 0) continue;
-                CHECK(result->selected[p] == -1);
-                CHECK(result->allocations[p].alpha == std::vector<double>{0.5, 0.5});
-            }
-        }
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  PixelSampleList usable = stratified(sqrtPlus, 2, 10);
+  std::vector<PixelSampleList> pixels(6, usable);
+  for (Sample& s : pixels[1]) s.f = s.technique == 1 ? 0.0f : s.f;             // technique 1 silent
+  for (Sample& s : pixels[2]) s.technique = &s == &pixels[2].front() ? 1 : 0;  // one sample of technique 1
+  pixels[3][5].f = nan;                                                        // non-finite value
+  for (Sample& s : pixels[4]) s.f = 0.0f;                                      // no signal at all
+  pixels[5][3].pdf[1] = inf;                                                   // non-finite pdf
+  const unsigned expected[] = {kFallbackNone,      kFallbackSilentTechnique, kFallbackTooFewSamples,
+                               kFallbackNonFinite, kFallbackNoSignal,        kFallbackNonFinite};
+  for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
+    BothResults r = searchBoth(pixels, 2, {1.0, 1.0}, rule);
+    for (const GridSearchResult* result : {&r.device, &r.reference}) {
+      CHECK(result->fallbackCount() == 5);
+      for (int p = 0; p < 6; ++p) {
+        INFO(fmt::format("rule {}, pixel {}", int(rule), p));
+        CHECK(result->allocations[p].fallbacks == expected[p]);
+        if (p == 0) continue;
+        CHECK(result->selected[p] == -1);
+        CHECK(result->allocations[p].alpha == std::vector<double>{0.5, 0.5});
+      }
     }
+  }
+}
+
+TEST_CASE("a layout that does not match the samples is rejected", "[exact]") {
+  std::vector<PixelSampleList> pixels(3, stratified(sqrtPlus, 2, 4));
+  StoredSampleLayout layout = layoutOf(pixels, 2, 8);
+  std::vector<float> samples = store(pixels, layout);
+  cl::Buffer buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
+                    samples.data());
+  const std::vector<double> costs{1.0, 1.0};
+  StoredSampleLayout overfull = layout, tooLarge = layout, wrongM = layout;
+  overfull.taken = layout.capacity + 1;
+  tooLarge.pixelCount = 17;  // a second block the buffer does not hold
+  wrongM.techniqueCount = 3;
+  for (const StoredSampleLayout& bad : {overfull, tooLarge}) {
+    CHECK_THROWS_AS(deviceSearch(2).run(buffer, bad, costs), std::invalid_argument);
+    CHECK_THROWS_AS(gridSearchReference(samples, bad, costs), std::invalid_argument);
+  }
+  CHECK_THROWS_AS(deviceSearch(2).run(buffer, wrongM, costs), std::invalid_argument);
+  CHECK(deviceSearch(2).run(buffer, layout, costs).fallbackCount() == 0);
 }

@@ -6,7 +6,6 @@
 #include <cfloat>
 #include <chrono>
 #include <stdexcept>
-#include <cstdlib>
 
 #include "KernelCode.h"
 namespace misalloc::kern {
@@ -35,78 +34,85 @@ constexpr int kPass = 16 * kGridVectors;
 constexpr int kLocalSize = 4;
 
 void checkTechniqueCount(int techniqueCount) {
-    if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
-        throw std::invalid_argument(fmt::format("grid search: {} techniques; it needs 2 to {}", techniqueCount,
-                                                kMaxTechniques));
+  if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
+    throw std::invalid_argument(
+        fmt::format("grid search: {} techniques; it needs 2 to {}", techniqueCount, kMaxTechniques));
 }
 
 void checkLayout(const StoredSampleLayout& layout, int techniqueCount, std::size_t availableFloats) {
-    if (layout.techniqueCount != techniqueCount)
-        throw std::invalid_argument(fmt::format("grid search: samples of {} techniques, search built for {}",
-                                                layout.techniqueCount, techniqueCount));
-    if (layout.pixelCount < 0 || layout.taken < 0 || layout.taken > layout.capacity)
-        throw std::invalid_argument(fmt::format("grid search: {} pixels, {} of {} samples taken", layout.pixelCount,
-                                                layout.taken, layout.capacity));
-    if (availableFloats < layout.floatCount())
-        throw std::invalid_argument(fmt::format("grid search: the samples hold {} floats, the layout needs {}",
-                                                availableFloats, layout.floatCount()));
+  if (layout.techniqueCount != techniqueCount)
+    throw std::invalid_argument(fmt::format("grid search: samples of {} techniques, search built for {}",
+                                            layout.techniqueCount, techniqueCount));
+  if (layout.pixelCount < 0 || layout.taken < 0 || layout.taken > layout.capacity)
+    throw std::invalid_argument(fmt::format("grid search: {} pixels, {} of {} samples taken", layout.pixelCount,
+                                            layout.taken, layout.capacity));
+  if (availableFloats < layout.floatCount())
+    throw std::invalid_argument(fmt::format("grid search: the samples hold {} floats, the layout needs {}",
+                                            availableFloats, layout.floatCount()));
 }
 
 // Appends every a ≥ 0 with Σ_k a_k = remaining over the techniques k ≥ first, in
 // lexicographic order, as the weights (a_k + 1/M) / (r + 1).
 void appendLattice(std::vector<int>& a, int first, int remaining, int resolution, std::vector<float>& alpha) {
-    int m = static_cast<int>(a.size());
-    if (first == m - 1) {
-        a[first] = remaining;
-        for (int k = 0; k < m; ++k) alpha.push_back(float((a[k] + 1.0 / m) / (resolution + 1)));
-        return;
-    }
-    for (a[first] = 0; a[first] <= remaining; ++a[first])
-        appendLattice(a, first + 1, remaining - a[first], resolution, alpha);
+  int m = static_cast<int>(a.size());
+  if (first == m - 1) {
+    a[first] = remaining;
+    for (int k = 0; k < m; ++k) alpha.push_back(float((a[k] + 1.0 / m) / (resolution + 1)));
+    return;
+  }
+  for (a[first] = 0; a[first] <= remaining; ++a[first])
+    appendLattice(a, first + 1, remaining - a[first], resolution, alpha);
 }
 
 // C(r + M − 1, M − 1): the lattice points of resolution r.
 long latticeSize(int techniqueCount, int resolution) {
-    long n = 1;
-    for (int k = 1; k < techniqueCount; ++k) n = n * (resolution + k) / k;
-    return n;
+  long n = 1;
+  for (int k = 1; k < techniqueCount; ++k) n = n * (resolution + k) / k;
+  return n;
 }
 
 int closestResolution(int techniqueCount, int approximateSize) {
-    int r = 0;
-    while (latticeSize(techniqueCount, r + 1) <= approximateSize) ++r;
-    long below = latticeSize(techniqueCount, r), above = latticeSize(techniqueCount, r + 1);
-    return above - approximateSize <= approximateSize - below ? r + 1 : r;
+  int r = 0;
+  while (latticeSize(techniqueCount, r + 1) <= approximateSize) ++r;
+  long below = latticeSize(techniqueCount, r), above = latticeSize(techniqueCount, r + 1);
+  return above - approximateSize <= approximateSize - below ? r + 1 : r;
 }
 
-// The grid as the passes read it: α_{k,l} at [k · paddedSize + l], the size rounded up
-// to whole passes with copies of the last combination, which never win a tie.
+// The grid as the passes read it: α_{k,l} at [k · paddedSize + l] and the cost per
+// sample at [l], the size rounded up to whole passes with copies of the last
+// combination, which are summed but never selected.
 struct LaneGrid {
-    int paddedSize;
-    std::vector<float> alpha;
+  int paddedSize;
+  std::vector<float> alpha, cost;
 };
 
 LaneGrid laneGrid(const WeightGrid& grid) {
-    const int m = grid.techniqueCount, u = grid.size();
-    LaneGrid lanes{(u + kPass - 1) / kPass * kPass, {}};
-    lanes.alpha.resize(std::size_t(m) * lanes.paddedSize);
-    for (int k = 0; k < m; ++k)
-        for (int l = 0; l < lanes.paddedSize; ++l) lanes.alpha[k * lanes.paddedSize + l] = grid.alpha[std::min(l, u - 1) * m + k];
-    return lanes;
+  const int m = grid.techniqueCount, u = grid.size();
+  LaneGrid lanes{(u + kPass - 1) / kPass * kPass, {}, {}};
+  lanes.alpha.resize(std::size_t(m) * lanes.paddedSize);
+  lanes.cost.resize(lanes.paddedSize);
+  for (int l = 0; l < lanes.paddedSize; ++l) {
+    int last = std::min(l, u - 1);
+    for (int k = 0; k < m; ++k) lanes.alpha[k * lanes.paddedSize + l] = grid.alpha[last * m + k];
+    lanes.cost[l] = grid.cost[last];
+  }
+  return lanes;
 }
 
-std::vector<float> toFloats(const std::vector<double>& values) { return std::vector<float>(values.begin(), values.end()); }
+std::vector<float> toFloats(const std::vector<double>& values) {
+  return std::vector<float>(values.begin(), values.end());
+}
 
 int kernelRule(GridRule rule) { return rule == GridRule::MaxEntropy ? MA_RULE_MAX_ENTROPY : MA_RULE_MIN_COST_VARIANCE; }
 
 // The inputs of one reference search, shared by every pixel.
 struct SearchSetup {
-    const float* samples;
-    StoredSampleLayout layout;
-    WeightGrid grid;
-    LaneGrid lanes;
-    std::vector<float> cost;  // c_k
-    int rule;
+  const float* samples;
+  StoredSampleLayout layout;
+  WeightGrid grid;
+  LaneGrid lanes;
+  std::vector<float> cost;  // c_k
+  int rule;
 };
 
 // Σ g and Σ g² over each technique's samples for every combination l, at
@@ -115,203 +121,211 @@ struct SearchSetup {
 template <int M>
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
               float* sumG2) {
-    const int padded = setup.lanes.paddedSize;
-    const float* alpha = setup.lanes.alpha.data();
-    for (int j = 0; j < M; ++j) {
-        float* s = sumG + j * padded;
-        float* s2 = sumG2 + j * padded;
-        std::fill(s, s + padded, 0.0f);
-        std::fill(s2, s2 + padded, 0.0f);
-        const float* x = prepared + kern::preparedFirst(summary, j) * (M + 1);
-        for (int i = 0; i < summary.nonZero[j]; ++i, x += M + 1) {
-            for (int l0 = 0; l0 < padded; l0 += kPass) {
+  const int padded = setup.lanes.paddedSize;
+  const float* alpha = setup.lanes.alpha.data();
+  for (int j = 0; j < M; ++j) {
+    float* s = sumG + j * padded;
+    float* s2 = sumG2 + j * padded;
+    std::fill(s, s + padded, 0.0f);
+    std::fill(s2, s2 + padded, 0.0f);
+    const float* x = prepared + kern::preparedFirst(summary, j) * (M + 1);
+    for (int i = 0; i < summary.nonZero[j]; ++i, x += M + 1) {
+      for (int l0 = 0; l0 < padded; l0 += kPass) {
 #pragma omp simd
-                for (int lane = 0; lane < 16; ++lane) {
-                    float p[kGridVectors], g[kGridVectors];
-                    for (int v = 0; v < kGridVectors; ++v) {
-                        int l = l0 + 16 * v + lane;
-                        p[v] = alpha[l] * x[1];
-                        for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
-                    }
-                    MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
-                    for (int v = 0; v < kGridVectors; ++v) {
-                        int l = l0 + 16 * v + lane;
-                        s[l] += g[v];
-                        s2[l] = std::fma(g[v], g[v], s2[l]);
-                    }
-                }
-            }
+        for (int lane = 0; lane < 16; ++lane) {
+          float p[kGridVectors], g[kGridVectors];
+          for (int v = 0; v < kGridVectors; ++v) {
+            int l = l0 + 16 * v + lane;
+            p[v] = alpha[l] * x[1];
+            for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
+          }
+          MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
+          for (int v = 0; v < kGridVectors; ++v) {
+            int l = l0 + 16 * v + lane;
+            s[l] += g[v];
+            s2[l] = std::fma(g[v], g[v], s2[l]);
+          }
         }
+      }
     }
+  }
 }
 
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
               float* sumG2) {
-    switch (setup.layout.techniqueCount) {
-        case 2: return sumPixel<2>(setup, summary, prepared, sumG, sumG2);
-        case 3: return sumPixel<3>(setup, summary, prepared, sumG, sumG2);
-        default: return sumPixel<4>(setup, summary, prepared, sumG, sumG2);
-    }
+  switch (setup.layout.techniqueCount) {
+    case 2:
+      return sumPixel<2>(setup, summary, prepared, sumG, sumG2);
+    case 3:
+      return sumPixel<3>(setup, summary, prepared, sumG, sumG2);
+    default:
+      return sumPixel<4>(setup, summary, prepared, sumG, sumG2);
+  }
 }
 
 // Per-thread buffers of the reference.
 struct Scratch {
-    std::vector<float> prepared, sumG, sumG2;
+  std::vector<float> prepared, sumG, sumG2;
 };
 
 // 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it.
 void searchPixel(const SearchSetup& setup, int pixel, Scratch& scratch, Allocation& allocation, int& selected) {
-    const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
-    const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
-    kern::PixelSummary summary = kern::emptySummary();
-    for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&summary, pixelSamples, m, i);
-    unsigned fallbacks = kern::pixelFallbacks(m, summary);
-    int best = -1;
-    if (fallbacks == 0) {
-        int next[kMaxTechniques];
-        for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(summary, j);
-        for (int i = 0; i < setup.layout.taken; ++i)
-            kern::prepareSample(pixelSamples, m, i, kern::sampleScale(summary), next, scratch.prepared.data());
-        sumPixel(setup, summary, scratch.prepared.data(), scratch.sumG.data(), scratch.sumG2.data());
-        float invCount[kMaxTechniques], bestScore = -INFINITY;
-        for (int j = 0; j < m; ++j) invCount[j] = 1.0f / summary.count[j];
-        for (int l = 0; l < setup.grid.size(); ++l) {
-            float g1[kMaxTechniques], g2[kMaxTechniques];
-            for (int j = 0; j < m; ++j) {
-                g1[j] = scratch.sumG[j * padded + l];
-                g2[j] = scratch.sumG2[j * padded + l];
-            }
-            float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l],
-                                          setup.cost.data(), g1, g2, invCount);
-            if (score > bestScore) {
-                bestScore = score;
-                best = l;
-            }
-        }
-        if (best < 0)
-            fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
+  const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
+  const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
+  kern::PixelSummary summary = kern::emptySummary();
+  for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&summary, pixelSamples, m, i);
+  unsigned fallbacks = kern::pixelFallbacks(m, summary);
+  int best = -1;
+  if (fallbacks == 0) {
+    int next[kMaxTechniques];
+    for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(summary, j);
+    for (int i = 0; i < setup.layout.taken; ++i)
+      kern::prepareSample(pixelSamples, m, i, kern::sampleScale(summary), next, scratch.prepared.data());
+    sumPixel(setup, summary, scratch.prepared.data(), scratch.sumG.data(), scratch.sumG2.data());
+    float invCount[kMaxTechniques], bestScore = -INFINITY;
+    for (int j = 0; j < m; ++j) invCount[j] = 1.0f / summary.count[j];
+    for (int l = 0; l < setup.grid.size(); ++l) {
+      float g1[kMaxTechniques], g2[kMaxTechniques];
+      for (int j = 0; j < m; ++j) {
+        g1[j] = scratch.sumG[j * padded + l];
+        g2[j] = scratch.sumG2[j * padded + l];
+      }
+      float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(), g1,
+                                    g2, invCount);
+      if (score > bestScore) {
+        bestScore = score;
+        best = l;
+      }
     }
-    selected = fallbacks == 0 ? best : -1;
-    allocation = fallbacks != 0 ? equalFallback(m, fallbacks)
-                                : Allocation{std::vector<double>(&setup.grid.alpha[best * m], &setup.grid.alpha[best * m] + m)};
+    if (best < 0) fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
+  }
+  selected = fallbacks == 0 ? best : -1;
+  allocation = fallbacks != 0
+                   ? equalFallback(m, fallbacks)
+                   : Allocation{std::vector<double>(&setup.grid.alpha[best * m], &setup.grid.alpha[best * m] + m)};
 }
 
 }  // namespace
 
 WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::vector<double>& costs) {
-    checkTechniqueCount(techniqueCount);
-    validateCosts(costs, techniqueCount);
-    if (approximateSize < 1) throw std::invalid_argument("grid search: the grid needs at least one combination");
-    int resolution = closestResolution(techniqueCount, approximateSize);
-    WeightGrid grid;
-    grid.techniqueCount = techniqueCount;
-    std::vector<int> a(techniqueCount);
-    appendLattice(a, 0, resolution, resolution, grid.alpha);
-    for (std::size_t l = 0; l < grid.alpha.size() / techniqueCount; ++l) {
-        double meanCost = 0;
-        for (int k = 0; k < techniqueCount; ++k) meanCost += costs[k] * grid.alpha[l * techniqueCount + k];
-        grid.cost.push_back(float(meanCost));
-    }
-    return grid;
+  checkTechniqueCount(techniqueCount);
+  validateCosts(costs, techniqueCount);
+  if (approximateSize < 1) throw std::invalid_argument("grid search: the grid needs at least one combination");
+  int resolution = closestResolution(techniqueCount, approximateSize);
+  WeightGrid grid;
+  grid.techniqueCount = techniqueCount;
+  std::vector<int> a(techniqueCount);
+  appendLattice(a, 0, resolution, resolution, grid.alpha);
+  for (std::size_t l = 0; l < grid.alpha.size() / techniqueCount; ++l) {
+    double meanCost = 0;
+    for (int k = 0; k < techniqueCount; ++k) meanCost += costs[k] * grid.alpha[l * techniqueCount + k];
+    grid.cost.push_back(float(meanCost));
+  }
+  return grid;
 }
 
 std::size_t StoredSampleLayout::floatCount() const {
-    return (std::size_t(pixelCount) + 15) / 16 * 16 * std::size_t(capacity) * std::size_t(techniqueCount + 2);
+  return (std::size_t(pixelCount) + 15) / 16 * 16 * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
 
 int GridSearchResult::fallbackCount() const {
-    return static_cast<int>(std::count_if(allocations.begin(), allocations.end(),
-                                          [](const Allocation& a) { return a.usedFallback(); }));
+  return static_cast<int>(
+      std::count_if(allocations.begin(), allocations.end(), [](const Allocation& a) { return a.usedFallback(); }));
 }
 
 GridSearch::GridSearch(const Device& device, int techniqueCount) : device_(device), techniqueCount_(techniqueCount) {
-    checkTechniqueCount(techniqueCount);
-    cl::Program program = buildProgram(device, "gridsearch.cl",
-                                       fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={} {}",
-                                                   techniqueCount, kGridVectors, std::getenv("GS_OPTS") ? std::getenv("GS_OPTS") : ""));
-    kernel_ = cl::Kernel(program, "gridSearch");
+  checkTechniqueCount(techniqueCount);
+  cl::Program program =
+      buildProgram(device, "gridsearch.cl",
+                   fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors));
+  kernel_ = cl::Kernel(program, "gridSearch");
 }
 
 GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLayout& layout,
                                  const std::vector<double>& costs, int gridSize, GridRule rule) {
-    checkLayout(layout, techniqueCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
-    WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize, costs);
-    const int m = techniqueCount_, pixels = layout.pixelCount;
-    GridSearchResult result;
-    if (pixels == 0) return result;
-    auto upload = [&](std::vector<float> data) {
-        return cl::Buffer(device_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(float),
-                          data.data());
-    };
-    LaneGrid lanes = laneGrid(grid);
-    cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(grid.cost), cost = upload(toFloats(costs));
-    // At least one float: a zero-size buffer is invalid.
-    cl::Buffer prepared(device_.context, CL_MEM_READ_WRITE,
-                        std::max<std::size_t>(1, (std::size_t(pixels) + 15) / 16 * 16 * layout.taken * (m + 1)) * sizeof(float));
-    cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
-    cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
-    cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
-    int a = 0;
-    kernel_.setArg(a++, samples);
-    kernel_.setArg(a++, cl_int(layout.capacity));
-    kernel_.setArg(a++, cl_int(layout.taken));
-    kernel_.setArg(a++, cl_int(pixels));
-    kernel_.setArg(a++, gridLanes);
-    kernel_.setArg(a++, gridCost);
-    kernel_.setArg(a++, cl_int(grid.size()));
-    kernel_.setArg(a++, cl_int(lanes.paddedSize));
-    kernel_.setArg(a++, cost);
-    kernel_.setArg(a++, cl_int(kernelRule(rule)));
-    kernel_.setArg(a++, prepared);
-    kernel_.setArg(a++, alphaOut);
-    kernel_.setArg(a++, selectedOut);
-    kernel_.setArg(a++, fallbacksOut);
-    cl::Event done;
-    const int blocks = (pixels + 15) / 16;
-    device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange((blocks + kLocalSize - 1) / kLocalSize * kLocalSize), cl::NDRange(kLocalSize), nullptr,
-                                       &done);
-    done.wait();
-    result.seconds = double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                            done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-                     1e-9;
+  checkLayout(layout, techniqueCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
+  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize, costs);
+  const int m = techniqueCount_, pixels = layout.pixelCount;
+  GridSearchResult result;
+  if (pixels == 0) return result;
+  auto upload = [&](std::vector<float> data) {
+    return cl::Buffer(device_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data.size() * sizeof(float),
+                      data.data());
+  };
+  LaneGrid lanes = laneGrid(grid);
+  cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(lanes.cost), cost = upload(toFloats(costs));
+  // The prepared samples' buffer is kept from run to run: a new one costs the kernel
+  // a page fault per 4 KiB, and page faults do not scale across threads.
+  std::size_t preparedFloats = std::max<std::size_t>(1, (std::size_t(pixels) + 15) / 16 * 16 * layout.taken * (m + 1));
+  if (preparedFloats > preparedFloats_) {
+    prepared_ = cl::Buffer(device_.context, CL_MEM_READ_WRITE, preparedFloats * sizeof(float));
+    preparedFloats_ = preparedFloats;
+  }
+  cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
+  cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
+  cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
+  int a = 0;
+  kernel_.setArg(a++, samples);
+  kernel_.setArg(a++, cl_int(layout.capacity));
+  kernel_.setArg(a++, cl_int(layout.taken));
+  kernel_.setArg(a++, cl_int(pixels));
+  kernel_.setArg(a++, gridLanes);
+  kernel_.setArg(a++, gridCost);
+  kernel_.setArg(a++, cl_int(grid.size()));
+  kernel_.setArg(a++, cl_int(lanes.paddedSize));
+  kernel_.setArg(a++, cost);
+  kernel_.setArg(a++, cl_int(kernelRule(rule)));
+  kernel_.setArg(a++, prepared_);
+  kernel_.setArg(a++, alphaOut);
+  kernel_.setArg(a++, selectedOut);
+  kernel_.setArg(a++, fallbacksOut);
+  cl::Event done;
+  const int blocks = (pixels + 15) / 16;
+  device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange,
+                                     cl::NDRange((blocks + kLocalSize - 1) / kLocalSize * kLocalSize),
+                                     cl::NDRange(kLocalSize), nullptr, &done);
+  done.wait();
+  result.seconds =
+      double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+      1e-9;
 
-    std::vector<float> alpha(std::size_t(pixels) * m);
-    std::vector<cl_uint> fallbacks(pixels);
-    result.selected.resize(pixels);
-    device_.queue.enqueueReadBuffer(alphaOut, CL_FALSE, 0, alpha.size() * sizeof(float), alpha.data());
-    device_.queue.enqueueReadBuffer(selectedOut, CL_FALSE, 0, pixels * sizeof(cl_int), result.selected.data());
-    device_.queue.enqueueReadBuffer(fallbacksOut, CL_TRUE, 0, pixels * sizeof(cl_uint), fallbacks.data());
-    result.allocations.reserve(pixels);
-    for (int p = 0; p < pixels; ++p) {
-        const float* a = &alpha[std::size_t(p) * m];
-        result.allocations.push_back(fallbacks[p] != 0 ? equalFallback(m, fallbacks[p])
-                                                       : Allocation{std::vector<double>(a, a + m)});
-    }
-    return result;
+  std::vector<float> alpha(std::size_t(pixels) * m);
+  std::vector<cl_uint> fallbacks(pixels);
+  result.selected.resize(pixels);
+  device_.queue.enqueueReadBuffer(alphaOut, CL_FALSE, 0, alpha.size() * sizeof(float), alpha.data());
+  device_.queue.enqueueReadBuffer(selectedOut, CL_FALSE, 0, pixels * sizeof(cl_int), result.selected.data());
+  device_.queue.enqueueReadBuffer(fallbacksOut, CL_TRUE, 0, pixels * sizeof(cl_uint), fallbacks.data());
+  result.allocations.reserve(pixels);
+  for (int p = 0; p < pixels; ++p) {
+    const float* weights = &alpha[std::size_t(p) * m];
+    result.allocations.push_back(fallbacks[p] != 0 ? equalFallback(m, fallbacks[p])
+                                                   : Allocation{std::vector<double>(weights, weights + m)});
+  }
+  return result;
 }
 
 GridSearchResult gridSearchReference(const std::vector<float>& samples, const StoredSampleLayout& layout,
                                      const std::vector<double>& costs, int gridSize, GridRule rule) {
-    checkTechniqueCount(layout.techniqueCount);
-    checkLayout(layout, layout.techniqueCount, samples.size());
-    WeightGrid grid = makeWeightGrid(layout.techniqueCount, gridSize, costs);
-    SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
-    const std::size_t sums = std::size_t(layout.techniqueCount) * setup.lanes.paddedSize;
+  checkTechniqueCount(layout.techniqueCount);
+  checkLayout(layout, layout.techniqueCount, samples.size());
+  WeightGrid grid = makeWeightGrid(layout.techniqueCount, gridSize, costs);
+  SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
+  const std::size_t sums = std::size_t(layout.techniqueCount) * setup.lanes.paddedSize;
 
-    GridSearchResult result;
-    result.allocations.resize(layout.pixelCount);
-    result.selected.resize(layout.pixelCount);
-    auto start = std::chrono::steady_clock::now();
+  GridSearchResult result;
+  result.allocations.resize(layout.pixelCount);
+  result.selected.resize(layout.pixelCount);
+  auto start = std::chrono::steady_clock::now();
 #pragma omp parallel
-    {
-        Scratch scratch{std::vector<float>(std::size_t(layout.taken) * (layout.techniqueCount + 1)),
-                        std::vector<float>(sums), std::vector<float>(sums)};
+  {
+    Scratch scratch{std::vector<float>(std::size_t(layout.taken) * (layout.techniqueCount + 1)),
+                    std::vector<float>(sums), std::vector<float>(sums)};
 #pragma omp for schedule(dynamic, 16)
-        for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
-            searchPixel(setup, pixel, scratch, result.allocations[pixel], result.selected[pixel]);
-    }
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return result;
+    for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
+      searchPixel(setup, pixel, scratch, result.allocations[pixel], result.selected[pixel]);
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
 }
 
 }  // namespace misalloc

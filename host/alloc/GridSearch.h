@@ -61,7 +61,9 @@ struct GridSearchResult {
   int fallbackCount() const;
 };
 
-// Runs kernels/gridsearch.cl; the program is built once for M techniques.
+// Runs kernels/gridsearch.cl; the program is built once for M techniques. A scratch
+// buffer of taken · (M + 1) floats per pixel, for the samples as the sums read them,
+// is kept from run to run.
 class GridSearch {
  public:
   GridSearch(const Device& device, int techniqueCount);
@@ -75,6 +77,8 @@ class GridSearch {
   const Device& device_;
   int techniqueCount_;
   cl::Kernel kernel_;
+  cl::Buffer prepared_;
+  std::size_t preparedFloats_ = 0;
 };
 
 // The same search with plain loops, one pixel per OpenMP iteration and the weight

@@ -3,9 +3,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <sstream>
 
 #include "Error.h"
+#include "NumberList.h"
 
 namespace misalloc {
 
@@ -27,24 +27,10 @@ std::vector<double> measureCosts(StageSampler& calibration, int spp) {
 }
 
 std::vector<double> parseCosts(const std::string& list, int techniqueCount) {
-  std::vector<double> costs;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    size_t used = 0;
-    double c = 0;
-    try {
-      c = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(c))
-      throw InputError(fmt::format("--cost {}: '{}' is not a number", list, item));
-    if (c <= 0) throw InputError(fmt::format("--cost {}: costs must be positive, got {}", list, item));
-    costs.push_back(c);
-  }
-  if (int(costs.size()) != techniqueCount)
-    throw InputError(fmt::format("--cost {}: expected {} costs, one per technique", list, techniqueCount));
+  std::vector<double> costs =
+      parseNumberList("--cost", list, list, size_t(techniqueCount), "one cost per technique");
+  for (double c : costs)
+    if (c <= 0) throw InputError(fmt::format("--cost {}: costs must be positive, got {}", list, c));
   return costs;
 }
 

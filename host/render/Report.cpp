@@ -73,6 +73,14 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"fallback_pixel_fraction", double(r.fallbackPixels) / pixels},
         {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
     };
+    if (run.method == Method::Exact || run.method == Method::Oracle) {
+      report["allocation"]["grid_u"] = run.adaptive.gridSize;
+      report["allocation"]["grid_selection"] =
+          run.method == Method::Exact && run.adaptive.gridRule == GridRule::MaxEntropy
+              ? "maximum entropy of normalised lambda (000 Alg. 1 line 13)"
+              : "minimum cost x multi-sample variance (002 eq. 21)";
+    }
+    if (run.method == Method::Oracle) report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
     if (run.method == Method::Linear)
       report["allocation"]["zero_weight_rule"] = run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance
                                                      ? "min sample variance (003 eq. 19)"

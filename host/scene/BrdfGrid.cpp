@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <sstream>
 
 #include "Error.h"
+#include "NumberList.h"
 
 namespace misalloc {
 namespace {
@@ -15,24 +15,7 @@ namespace {
 const char* kForms = "seed000, general:RD0,RD1,N0,N1 or uniform:RD,RS,N";
 
 std::vector<double> parseNumbers(const std::string& spec, const std::string& list, size_t expected) {
-  std::vector<double> values;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(v))
-      throw InputError(fmt::format("--grid {}: '{}' is not a number (expected {})", spec, item, kForms));
-    values.push_back(v);
-  }
-  if (values.size() != expected)
-    throw InputError(fmt::format("--grid {}: expected {} numbers (forms: {})", spec, expected, kForms));
-  return values;
+  return parseNumberList("--grid", spec, list, expected, std::string("forms: ") + kForms);
 }
 
 void checkParameters(const std::string& spec, double rhoD, double rhoS, double n) {
