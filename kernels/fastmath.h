@@ -1,4 +1,4 @@
-// Inlinable float approximations of log2, exp2, pow, sin/cos, acos and atan2.
+// Inlinable float approximations of log2, exp2, pow, log1p, expm1, sin/cos, acos and atan2.
 // OpenCL builtins are opaque calls on PoCL that cost up to ~400 cycles and keep the
 // kernel scalar (../shared/notes/pocl-performance.md, rule 2); these vectorise.
 // tests/test_fastmath.cpp bounds their error against the C++ standard library.
@@ -49,6 +49,39 @@ MA_FN float fastExp2(float y) {
 
 // x^y for x ≥ 0, y > 0 (0^y = 0).
 MA_FN float fastPow(float x, float y) { return x > 0.0f ? fastExp2(y * fastLog2(x)) : 0.0f; }
+
+// ln(1 + x) for x > -1, accurate to a few ulps relative to the result also where
+// |x| is tiny (Goldberg 1991, Thm. 4): with u = fl(1 + x), ln(1 + x) = ln(u) x/(u − 1),
+// since u − 1 is exact; x itself where u rounds to 1. No branch: a select.
+MA_FN float fastLog1p(float x) {
+  float u = 1.0f + x;
+  float du = u - 1.0f;
+  float q = du != 0.0f ? x / du : 1.0f;
+  float l = fastLog2(ma_max(u, 1e-38f)) * MA_LN2;
+  return du != 0.0f ? l * q : x;
+}
+
+// e^x − 1 for x ≤ 0 (the Phong sampler's range), accurate relative to the result
+// also for tiny |x|: a degree-9 Taylor polynomial where |x| < 1/2 (truncation
+// < 3e-10 relative), fastExp2 − 1 elsewhere, where no cancellation occurs. A select.
+MA_FN float fastExpm1(float x) {
+  float series =
+      x * ma_fma(x,
+                 ma_fma(x,
+                        ma_fma(x,
+                               ma_fma(x,
+                                      ma_fma(x,
+                                             ma_fma(x, ma_fma(x, ma_fma(x, 1.0f / 362880.0f, 1.0f / 40320.0f),
+                                                              1.0f / 5040.0f),
+                                                    1.0f / 720.0f),
+                                             1.0f / 120.0f),
+                                      1.0f / 24.0f),
+                               1.0f / 6.0f),
+                        0.5f),
+                 1.0f);
+  float direct = fastExp2(x * MA_LOG2E) - 1.0f;
+  return ma_abs(x) < 0.5f ? series : direct;
+}
 
 typedef struct {
   float s, c;

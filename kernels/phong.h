@@ -12,9 +12,23 @@ typedef struct {
   float rhoD, rhoS, n;
 } PhongParams;
 
+// 1 − cos α between two unit vectors as |a − b|²/2: accurate relative to itself
+// near α = 0, where 1 − dot(a, b) loses every digit at float resolution (1 − cos α
+// ≈ 1e-5 for n = 10⁵). For a direction built by directionAboutD, |ω − r|² = 2 d holds
+// whatever the rounding of |ω|.
+MA_FN float oneMinusCos(MaVec3 a, MaVec3 b) {
+  float x = a.x - b.x, y = a.y - b.y, z = a.z - b.z;
+  return 0.5f * (x * x + y * y + z * z);
+}
+
 // cos^n α, α the angle between ω_i and the mirror direction; 0 beyond 90°. The BRDF
-// and both pdfs share it: it is the costliest term of a sample.
-MA_FN float phongLobe(PhongParams b, MaVec3 wi, MaVec3 mirror) { return fastPow(dot3(wi, mirror), b.n); }
+// and both pdfs share it: it is the costliest term of a sample. exp(n ln(1 − d)) with
+// d = 1 − cos α computed accurately, so that n up to 10⁵ keeps float precision.
+MA_FN float phongLobe(PhongParams b, MaVec3 wi, MaVec3 mirror) {
+  float d = oneMinusCos(wi, mirror);
+  float lobe = fastExp2(b.n * MA_LOG2E * fastLog1p(-ma_min(d, 0.99999994f)));
+  return d < 1.0f ? lobe : 0.0f;
+}
 
 // f = ρd/π + ρs (n+2)/(2π) cos^n α.
 MA_FN float phongBrdf(PhongParams b, float lobe) {
@@ -58,13 +72,24 @@ MA_FN MaVec3 directionAbout(MaVec3 axis, float cosAlpha, float u) {
   return lobeToWorld(axis, sinAlpha * phi.c, sinAlpha * phi.s, cosAlpha);
 }
 
+// A direction about `axis` with 1 − cos = d ∈ [0, 2] and azimuth 2πu: sin α =
+// √(d (2 − d)) keeps its precision where cos α rounds to 1.
+MA_FN MaVec3 directionAboutD(MaVec3 axis, float d, float u) {
+  float sinAlpha = ma_sqrt(ma_max(d * (2.0f - d), 0.0f));
+  MaSinCos phi = sinCos2Pi(u);
+  return lobeToWorld(axis, sinAlpha * phi.c, sinAlpha * phi.s, 1.0f - d);
+}
+
 MA_FN MaVec3 sampleDiffuse(float u1, float u2) {
   return directionAbout(makeVec3(0.0f, 0.0f, 1.0f), ma_sqrt(1.0f - u1), u2);
 }
 
-// cos α = u^(1/(n+1)) inverts the CDF of the cos^n lobe.
+// cos α = u^(1/(n+1)) inverts the CDF of the cos^n lobe (u = 1 − u1 ∈ (0, 1]), taken
+// as 1 − cos α = −expm1(ln u / (n+1)) so that it stays exact to float precision for
+// n up to 10⁵, where cos α itself is within a few ulps of 1.
 MA_FN MaVec3 sampleSpecular(PhongParams b, MaVec3 mirror, float u1, float u2) {
-  return directionAbout(mirror, fastPow(1.0f - u1, 1.0f / (b.n + 1.0f)), u2);
+  float d = -fastExpm1(fastLog2(1.0f - u1) * MA_LN2 / (b.n + 1.0f));
+  return directionAboutD(mirror, d, u2);
 }
 
 MA_FN MaVec3 sampleBrdf(PhongParams b, MaVec3 mirror, MaRandom4 rnd) {

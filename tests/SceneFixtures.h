@@ -1,5 +1,6 @@
 #pragma once
 // Small scenes and per-pixel statistics shared by the sampler tests.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -41,6 +42,20 @@ inline MeanAndError pixelMean(const std::vector<double>& rgb) {
   double mean = sum / n;
   double variance = (sumSquares - n * mean * mean) / (n - 1);
   return {mean, std::sqrt(std::max(variance, 0.0) / n)};
+}
+
+// |z| < 4: a false alarm has probability 6e-5 per check for a correct estimator.
+constexpr double kMaxZ = 4.0;
+
+// A zero-variance estimator (f ∝ p) still carries float rounding: each sample's
+// f/(N p) is a float, ~1e-7 relative. The error it is measured against has that floor.
+inline double zScore(double mean, double expected, double standardError) {
+  return (mean - expected) / std::max(standardError, 1e-6 * std::abs(expected));
+}
+
+// 000 eq. 6.17: the pixel value under R = cos^K θ with ω_o along the normal, R = 1.
+inline double closedForm(double rhoD, double rhoS, double n, double K) {
+  return 2 * rhoD / (K + 2) + rhoS * (n + 2) / (n + K + 2);
 }
 
 }  // namespace misalloc::test

@@ -14,18 +14,6 @@ using namespace misalloc::test;
 
 namespace {
 
-// |z| < 4: a false alarm has probability 6e-5 per check for a correct estimator.
-constexpr double kMaxZ = 4.0;
-
-// A zero-variance estimator (f ∝ p) still carries float rounding: each sample's
-// f/(N p) is a float, ~1e-7 relative. The error it is measured against has that floor.
-double zScore(double mean, double expected, double standardError) {
-  return (mean - expected) / std::max(standardError, 1e-6 * std::abs(expected));
-}
-
-double closedForm(double rhoD, double rhoS, double n, double K) {
-  return 2 * rhoD / (K + 2) + rhoS * (n + 2) / (n + K + 2);  // 000 eq. 6.17, R = 1
-}
 
 MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, int spp, uint64_t seed) {
   Sampler sampler(testDevice(), scene, {estimator, 0, 0});

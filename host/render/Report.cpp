@@ -70,7 +70,9 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"pilot_fraction", run.adaptive.pilotFraction},
         {"costs_s_per_sample", costs},
         {"costs_source", run.costSource},
+        {"fallback_pixels", r.fallbackPixels},
         {"fallback_pixel_fraction", double(r.fallbackPixels) / pixels},
+        {"floored_pixels", r.flooredPixels},
         {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
     };
     if (run.method == Method::Exact || run.method == Method::Oracle) {
