@@ -10,11 +10,12 @@
 #define MA_STATS_BALANCE 2    // Σ f/Σ_l p_l and its square: σ_k of 002 eq. 27–28 (σ/√c)
 #define MA_STATS_LINEAR 4     // F_k = Σ f and P_ik = Σ p_i: 003 eq. 18 (linear)
 
-// Per technique: the count, then the sums that `mask` selects, in the order above. A
-// macro: kernels size local arrays with it.
-#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                 \
-  (1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
-   (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
+// Per technique: the count, then the sums that `mask` selects, in the order above; no
+// slot at all when the method keeps no sums. A macro: kernels size local arrays with it.
+#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                              \
+  ((mask) == 0 ? 0                                                                                \
+               : 1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
+                     (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
 
 // What sample s adds to slot `slot` of the sums of the technique that drew it. Squares
 // are taken in ma_acc: f/p can be near the top of the float range.

@@ -150,7 +150,11 @@ std::vector<double> Sampler::statistics() {
 }
 
 GridSearchResult Sampler::searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) {
-  if (!gridSearch_) gridSearch_ = std::make_unique<GridSearch>(device_, scene_.techniqueCount());
+  if (!gridSearch_) {
+    gridSearch_ = std::make_unique<GridSearch>(device_, scene_.techniqueCount());
+    // As for the sampling kernel: the first launch's compilation is not search time.
+    gridSearch_->run(samples_, storedSampleLayout(0), costs, gridSize, rule);
+  }
   return gridSearch_->run(samples_, storedSampleLayout(taken), costs, gridSize, rule);
 }
 
