@@ -8,11 +8,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "Error.h"
 #include "TestDevice.h"
 #include "cl/Device.h"
+#include "scene/ExrIO.h"
 
 namespace fs = std::filesystem;
 
@@ -101,6 +104,59 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
     CHECK_FALSE(fs::exists(out));
     CHECK_FALSE(fs::exists(report));
   }
+}
+
+TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[cli][bad-input]") {
+  TempDir dir;
+  auto file = [&](const std::string& name) { return (dir.path / name).string(); };
+  std::ofstream(file("garbage.exr")) << "#?RADIANCE\nnot an OpenEXR file\n";
+  std::ofstream(file("empty.exr"));
+  {
+    std::ifstream in(MISALLOC_SOURCE_DIR "/data/envmaps/lebombo.exr", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(file("cut.exr"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  misalloc::writeExrChannels(file("rg.exr"), 4, 2, {"R", "G"}, {std::vector<float>(8, 1.0f), std::vector<float>(8, 1.0f)});
+  misalloc::RgbImage nan{4, 2, std::vector<float>(24, 1.0f)};
+  nan.rgb[3 * (1 * 4 + 2) + 0] = std::numeric_limits<float>::quiet_NaN();  // x=2, y=1, R
+  misalloc::writeExr(file("nan.exr"), nan);
+  struct Case {
+    std::string name, expected;
+  };
+  const Case cases[] = {{"absent.exr", "no such file"},
+                        {"garbage.exr", "not an OpenEXR file"},
+                        {"empty.exr", "not an OpenEXR file"},
+                        {"cut.exr", "truncated or corrupt"},
+                        {"rg.exr", "no B channel"},
+                        {"nan.exr", "1 NaN or infinite channel values, the first at x=2, y=1, channel R"}};
+  auto out = dir.path / "r.exr", report = dir.path / "r.json";
+  for (const Case& c : cases) {
+    auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 4 --reference none --out {} --report {}",
+                                     file(c.name), out.string(), report.string()));
+    INFO(c.name << "\n" << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find(file(c.name)) != std::string::npos);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+    CHECK_FALSE(fs::exists(report));
+  }
+}
+
+TEST_CASE("negative texels are set to 0 with a warning and a count", "[cli][bad-input]") {
+  TempDir dir;
+  misalloc::RgbImage image{4, 2, std::vector<float>(24, 1.0f)};
+  image.rgb[3 * 1 + 2] = -2.0f;  // x=1, y=0, B
+  image.rgb[3 * 6 + 0] = -1.0f;
+  const std::string map = (dir.path / "neg.exr").string();
+  misalloc::writeExr(map, image);
+  auto report = dir.path / "r.json";
+  auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 4 --reference none --out {} --report {}", map,
+                                   (dir.path / "r.exr").string(), report.string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  CHECK(r.output.find("2 negative values set to 0 (first at x=1, y=0, channel B)") != std::string::npos);
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  CHECK(j["scene"]["envmap_negative_values_zeroed"] == 2);
 }
 
 TEST_CASE("an existing output survives a failed run", "[cli][bad-input]") {
