@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstring>
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -117,6 +118,18 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
     std::ofstream(file("cut.exr"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   }
   misalloc::writeExrChannels(file("rg.exr"), 4, 2, {"R", "G"}, {std::vector<float>(8, 1.0f), std::vector<float>(8, 1.0f)});
+  {
+    // OpenEXR cannot write an empty data window: patch max.x of a good file's below min.x.
+    misalloc::writeExr(file("good.exr"), misalloc::RgbImage{4, 2, std::vector<float>(24, 1.0f)});
+    std::ifstream in(file("good.exr"), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    size_t at = bytes.find(attribute);
+    REQUIRE(at != std::string::npos);
+    int32_t maxX = -1;
+    std::memcpy(&bytes[at + attribute.size() + 4 + 8], &maxX, 4);  // after the size, min.x, min.y
+    std::ofstream(file("zero.exr"), std::ios::binary) << bytes;
+  }
   misalloc::RgbImage nan{4, 2, std::vector<float>(24, 1.0f)};
   nan.rgb[3 * (1 * 4 + 2) + 0] = std::numeric_limits<float>::quiet_NaN();  // x=2, y=1, R
   misalloc::writeExr(file("nan.exr"), nan);
@@ -128,6 +141,7 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
                         {"empty.exr", "not an OpenEXR file"},
                         {"cut.exr", "truncated or corrupt"},
                         {"rg.exr", "no B channel"},
+                        {"zero.exr", "data window"},
                         {"nan.exr", "1 NaN or infinite channel values, the first at x=2, y=1, channel R"}};
   auto out = dir.path / "r.exr", report = dir.path / "r.json";
   for (const Case& c : cases) {
