@@ -181,9 +181,6 @@ int main(int argc, char** argv) {
       adaptive.gridRule = parseGridRule(gridRule);
       if (adaptive.gridSize < 2)
         throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", adaptive.gridSize));
-      if (adaptive.oracleSamples < 2 * 3)
-        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
-                                     adaptive.oracleSamples));
       checkWritableOutput(out, "--out");
       checkWritableOutput(reportPath, "--report");
       if (!alphaMap.empty()) {
@@ -193,6 +190,9 @@ int main(int argc, char** argv) {
       Scene scene = renderScene.make();
       if (isAdaptive(m) && m != Method::Oracle)
         stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
+      if (m == Method::Oracle && adaptive.oracleSamples < 2 * scene.techniqueCount())
+        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
+                                     adaptive.oracleSamples));
       std::string costSource = "--cost";
       if (!costList.empty()) adaptive.costs = parseCosts(costList, scene.techniqueCount());
       std::unique_ptr<Device> device;
@@ -210,7 +210,7 @@ int main(int argc, char** argv) {
         reference = findReference(plainSampler(), scene, referenceSpp, cacheDir, true);
       else if (referenceMode != "none")
         reference = Reference{readExr(referenceMode), "file", referenceMode};
-      if (reference) checkSameSize(reference->image, RgbImage{scene.grid.width, scene.grid.height, {}});
+      if (reference) checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
       if (isAdaptive(m) && adaptive.costs.empty()) {
         adaptive.costs = measureCosts(plainSampler());
         costSource = "measured";
