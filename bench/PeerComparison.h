@@ -40,6 +40,21 @@ inline void registerPeers(const std::string& name, std::function<void(benchmark:
         ->ReportAggregatesOnly(true);
 }
 
+// Takes the benchmark's own "--flag value" options out of argv, giving each value to
+// its setter, and returns the rest (argv[0] first) for Google Benchmark.
+inline std::vector<char*> takeFlags(int argc, char** argv,
+                                    const std::map<std::string, std::function<void(const char*)>>& setters) {
+  std::vector<char*> rest{argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    auto setter = setters.find(argv[i]);
+    if (setter != setters.end() && i + 1 < argc)
+      setter->second(argv[++i]);
+    else
+      rest.push_back(argv[i]);
+  }
+  return rest;
+}
+
 // Initialises Google Benchmark with interleaved repetitions (a later flag wins).
 inline void initialize(std::vector<char*> args) {
   static char interleave[] = "--benchmark_enable_random_interleaving=true";

@@ -12,7 +12,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <cstring>
 #include <iostream>
 #include <random>
 
@@ -106,22 +105,13 @@ void benchOpenMp(benchmark::State& state, GridRule rule) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest{argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    auto value = [&](const char* flag) { return std::strcmp(argv[i], flag) == 0 && i + 1 < argc; };
-    if (value("--device"))
-      config.device = argv[++i];
-    else if (value("--size"))
-      config.size = std::stoi(argv[++i]);
-    else if (value("--grid-u"))
-      config.gridSize = std::stoi(argv[++i]);
-    else if (value("--samples"))
-      config.samples = std::stoi(argv[++i]);
-    else if (value("--techniques"))
-      config.techniques = std::stoi(argv[++i]);
-    else
-      rest.push_back(argv[i]);
-  }
+  std::vector<char*> rest =
+      bench::takeFlags(argc, argv,
+                       {{"--device", [](const char* v) { config.device = v; }},
+                        {"--size", [](const char* v) { config.size = std::stoi(v); }},
+                        {"--grid-u", [](const char* v) { config.gridSize = std::stoi(v); }},
+                        {"--samples", [](const char* v) { config.samples = std::stoi(v); }},
+                        {"--techniques", [](const char* v) { config.techniques = std::stoi(v); }}});
   bench::initialize(rest);
   std::vector<std::string> names;
   for (const auto& [name, rule] : kRules) {

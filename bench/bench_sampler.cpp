@@ -8,7 +8,6 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include <cstring>
 #include <iostream>
 #include <memory>
 
@@ -76,18 +75,10 @@ void benchOpenMp(benchmark::State& state, const Variant& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest{argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    auto value = [&](const char* flag) { return std::strcmp(argv[i], flag) == 0 && i + 1 < argc; };
-    if (value("--device"))
-      config.device = argv[++i];
-    else if (value("--size"))
-      config.size = std::stoi(argv[++i]);
-    else if (value("--spp"))
-      config.spp = std::stoi(argv[++i]);
-    else
-      rest.push_back(argv[i]);
-  }
+  std::vector<char*> rest = bench::takeFlags(argc, argv,
+                                             {{"--device", [](const char* v) { config.device = v; }},
+                                              {"--size", [](const char* v) { config.size = std::stoi(v); }},
+                                              {"--spp", [](const char* v) { config.spp = std::stoi(v); }}});
   bench::initialize(rest);
   std::vector<std::string> names;
   for (const Variant& v : kVariants) {

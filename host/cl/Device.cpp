@@ -31,8 +31,6 @@ std::string Device::name() const {
   return fmt::format("{} ({})", device.getInfo<CL_DEVICE_NAME>(), platform.getInfo<CL_PLATFORM_NAME>());
 }
 
-bool Device::isGpu() const { return hasType(device, CL_DEVICE_TYPE_GPU); }
-
 std::vector<std::pair<cl::Platform, cl::Device>> enumerateDevices() {
   std::vector<std::pair<cl::Platform, cl::Device>> all;
   for (const auto& p : platforms()) {

@@ -14,7 +14,6 @@ struct Device {
   cl::CommandQueue queue;
 
   std::string name() const;
-  bool isGpu() const;
 };
 
 // Every device of every platform, in the order `misalloc devices` lists them.

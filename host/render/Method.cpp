@@ -46,12 +46,6 @@ std::string methodName(Method method) {
   return "?";
 }
 
-std::vector<Method> allMethods() {
-  std::vector<Method> all;
-  for (const auto& m : kMethods) all.push_back(m.method);
-  return all;
-}
-
 bool isAdaptive(Method method) { return method != Method::Envmap && method != Method::Brdf && method != Method::Equal; }
 
 Estimator methodEstimator(Method method) {

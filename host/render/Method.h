@@ -16,7 +16,6 @@ enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, O
 // Throws InputError for an unknown name.
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);
-std::vector<Method> allMethods();
 bool isAdaptive(Method method);
 
 // The estimator each method's stages use: σ/√c allocates for the estimator with
