@@ -26,8 +26,9 @@ std::vector<double> parseNumberList(const std::string& option, const std::string
       throw InputError(fmt::format("{} {}: '{}' is not a number ({})", option, value, item, forms));
     numbers.push_back(v);
   }
-  if (numbers.size() != expected)
+  if (expected > 0 && numbers.size() != expected)
     throw InputError(fmt::format("{} {}: expected {} numbers ({})", option, value, expected, forms));
+  if (numbers.empty()) throw InputError(fmt::format("{} '{}': expected at least one number ({})", option, value, forms));
   return numbers;
 }
 

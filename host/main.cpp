@@ -2,12 +2,21 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "AtomicFile.h"
 #include "Error.h"
+#include "NumberList.h"
 #include "cl/Device.h"
+#include "compare/CompareReport.h"
+#include "compare/Comparison.h"
+#include "compare/Suite.h"
+#include "compare/Summary.h"
+#include "compare/SummaryTables.h"
 #include "paper/PaperReport.h"
 #include "render/AlphaMap.h"
 #include "render/Costs.h"
@@ -17,6 +26,7 @@
 #include "render/Render.h"
 #include "render/Report.h"
 #include "render/Sampler.h"
+#include "render/SamplerChoice.h"
 
 using namespace misalloc;
 
@@ -66,13 +76,30 @@ struct SceneArgs {
   }
 };
 
-// The device is opened once; samplers built on it share it.
-std::unique_ptr<StageSampler> makeSampler(const std::string& deviceSpec, std::unique_ptr<Device>& device,
-                                          const Scene& scene, const SamplerConfig& config, int localSize) {
-  if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, config);
-  if (!device) device = std::make_unique<Device>(openDevice(deviceSpec));
-  return std::make_unique<Sampler>(*device, scene, config, localSize);
-}
+// The options of the adaptive methods, shared by render and compare.
+struct AdaptiveArgs {
+  AdaptiveOptions options;
+  std::string costList, linearRule = "variance", gridRule = "variance";
+
+  void add(CLI::App* app) {
+    app->add_option("--pilot", options.pilotFraction, "adaptive methods: the pilot's share of the budget")
+        ->capture_default_str();
+    app->add_option("--stages", options.stages, "adaptive methods: stages after the pilot")->capture_default_str();
+    app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
+    app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
+        ->capture_default_str();
+    app->add_option("--grid-u", options.gridSize, "exact, oracle: number U of weight combinations searched")
+        ->capture_default_str();
+    app->add_option("--grid-rule", gridRule,
+                    "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
+        ->capture_default_str();
+    app->add_option("--oracle-spp", options.oracleSamples, "oracle: probe samples per pixel")->capture_default_str();
+  }
+
+  // The options with the rules parsed and the costs, when given, checked for M
+  // techniques; throws InputError.
+  AdaptiveOptions make(int techniqueCount) const;
+};
 
 GridRule parseGridRule(const std::string& name) {
   if (name == "variance") return GridRule::MinCostVariance;
@@ -90,6 +117,42 @@ Estimator parseEstimator(const std::string& name) {
   if (name == "multi") return Estimator::MultiSample;
   if (name == "one") return Estimator::OneSample;
   throw InputError(fmt::format("--estimator '{}': expected multi or one", name));
+}
+
+AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
+  AdaptiveOptions o = options;
+  o.linearRule = parseLinearRule(linearRule);
+  o.gridRule = parseGridRule(gridRule);
+  if (o.gridSize < 2)
+    throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", o.gridSize));
+  if (!costList.empty()) o.costs = parseCosts(costList, techniqueCount);
+  return o;
+}
+
+// "all" or a comma-separated list of method names, each once.
+std::vector<Method> parseMethodList(const std::string& list) {
+  if (list == "all")
+    return {Method::Envmap, Method::Brdf,   Method::Equal, Method::Heuristic,
+            Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
+  std::vector<Method> methods;
+  std::stringstream items(list);
+  for (std::string item; std::getline(items, item, ',');) {
+    Method m = parseMethod(item);
+    if (std::find(methods.begin(), methods.end(), m) != methods.end())
+      throw InputError(fmt::format("--methods {}: {} is listed twice", list, item));
+    methods.push_back(m);
+  }
+  return methods;
+}
+
+std::vector<int> parseBudgets(const std::string& list) {
+  std::vector<int> budgets;
+  for (double v : parseNumberList("--budgets", list, list, 0, "expected spp,spp,... in ascending order")) {
+    if (v != std::floor(v) || v < 1 || v > 1e7)
+      throw InputError(fmt::format("--budgets {}: {} is not a whole number of samples per pixel", list, v));
+    budgets.push_back(int(v));
+  }
+  return budgets;
 }
 
 }  // namespace
@@ -112,22 +175,9 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str();
   renderCmd->add_option("--method", method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
       ->capture_default_str();
-  AdaptiveOptions adaptive;
-  std::string costList, alphaMap, linearRule = "variance";
-  renderCmd->add_option("--pilot", adaptive.pilotFraction, "adaptive methods: the pilot's share of the budget")
-      ->capture_default_str();
-  renderCmd->add_option("--stages", adaptive.stages, "adaptive methods: stages after the pilot")->capture_default_str();
-  renderCmd->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
-  renderCmd->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
-      ->capture_default_str();
-  std::string gridRule = "variance";
-  renderCmd->add_option("--grid-u", adaptive.gridSize, "exact, oracle: number U of weight combinations searched")
-      ->capture_default_str();
-  renderCmd->add_option("--grid-rule", gridRule,
-                        "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
-      ->capture_default_str();
-  renderCmd->add_option("--oracle-spp", adaptive.oracleSamples, "oracle: probe samples per pixel")
-      ->capture_default_str();
+  AdaptiveArgs renderAdaptive;
+  renderAdaptive.add(renderCmd);
+  std::string alphaMap;
   renderCmd->add_option("--alpha-map", alphaMap, "write the per-pixel allocation: EXR here, false-colour PNG beside");
   renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi (000 eq. 4.1) or one (one-sample MIS)")
       ->capture_default_str();
@@ -153,6 +203,31 @@ int main(int argc, char** argv) {
   referenceCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
   referenceCmd->add_option("--out", referenceOut, "also write the reference to this EXR");
 
+  auto* compareCmd = app.add_subcommand(
+      "compare", "error against time: methods x budgets x repeats, equal-time tables, plots and index.html");
+  SceneArgs compareScene;
+  compareScene.add(compareCmd);
+  AdaptiveArgs compareAdaptive;
+  compareAdaptive.add(compareCmd);
+  CompareOptions compare;
+  std::string methodList = "all", budgetList = "50,100,200,400,800";
+  bool suite = false;
+  compareCmd->add_flag("--suite", suite,
+                       "every shipped envmap x seed000 plus forest_slope with the cdf sampler, at 64x64 unless --size");
+  compareCmd->add_option("--methods", methodList, "comma-separated methods, or all")->capture_default_str();
+  compareCmd->add_option("--budgets", budgetList, "samples per pixel, ascending")->capture_default_str();
+  compareCmd->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
+      ->capture_default_str();
+  compareCmd->add_option("--seed", compare.seed, "repeat r uses seed + r")->capture_default_str();
+  compareCmd->add_option("--table-spp", compare.tableBudget, "the budget of the Table 5.2 layout (nearest one run)")
+      ->capture_default_str();
+  compareCmd->add_option("--out-dir", compare.outDir, "output folder (created if missing)")->required();
+  compareCmd->add_option("--device", compare.device, "auto, cpu, gpu, an index, or host (C++)")->capture_default_str();
+  compareCmd->add_option("--local-size", compare.localSize, "OpenCL work-group size")->capture_default_str();
+  compareCmd->add_option("--reference-spp", compare.referenceSpp, "spp of a sampled reference")->capture_default_str();
+  compare.cacheDir = defaultCacheDir();
+  compareCmd->add_option("--cache-dir", compare.cacheDir, "where references are cached")->capture_default_str();
+
   auto* paperCmd = app.add_subcommand("paper", "the papers' 1D examples: list them, or print one against the papers");
   std::string paperId;
   paperCmd->add_option("id", paperId, "example id (see `misalloc paper`)");
@@ -177,10 +252,6 @@ int main(int argc, char** argv) {
       Estimator estimator = parseEstimator(estimatorName);
       if (isAdaptive(m) && estimator != Estimator::MultiSample)
         throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", estimatorName));
-      adaptive.linearRule = parseLinearRule(linearRule);
-      adaptive.gridRule = parseGridRule(gridRule);
-      if (adaptive.gridSize < 2)
-        throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", adaptive.gridSize));
       checkWritableOutput(out, "--out");
       checkWritableOutput(reportPath, "--report");
       if (!alphaMap.empty()) {
@@ -188,21 +259,21 @@ int main(int argc, char** argv) {
         checkWritableOutput(alphaPngPath(alphaMap), "--alpha-map");
       }
       Scene scene = renderScene.make();
+      AdaptiveOptions adaptive = renderAdaptive.make(scene.techniqueCount());
+      std::string costSource = adaptive.costs.empty() ? "measured" : "--cost";
       if (isAdaptive(m) && m != Method::Oracle)
         stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
       if (m == Method::Oracle && adaptive.oracleSamples < 2 * scene.techniqueCount())
         throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
                                      adaptive.oracleSamples));
-      std::string costSource = "--cost";
-      if (!costList.empty()) adaptive.costs = parseCosts(costList, scene.techniqueCount());
       std::unique_ptr<Device> device;
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
-      auto sampler = makeSampler(deviceSpec, device, scene, config, localSize);
-      std::string deviceName = device ? device->name() : "host (C++ reference, OpenMP)";
+      auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);
+      std::string deviceName = samplerDeviceName(device);
       // Without statistics: for the reference and for measuring costs.
       std::unique_ptr<StageSampler> plain;
       auto plainSampler = [&]() -> StageSampler& {
-        if (!plain) plain = makeSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
+        if (!plain) plain = makeStageSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
         return *plain;
       };
       std::optional<Reference> reference;
@@ -211,10 +282,7 @@ int main(int argc, char** argv) {
       else if (referenceMode != "none")
         reference = Reference{readExr(referenceMode), "file", referenceMode};
       if (reference) checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
-      if (isAdaptive(m) && adaptive.costs.empty()) {
-        adaptive.costs = measureCosts(plainSampler());
-        costSource = "measured";
-      }
+      if (isAdaptive(m) && adaptive.costs.empty()) adaptive.costs = measureCosts(plainSampler());
       Rendering r = render(*sampler, m, adaptive, spp, seed);
       nlohmann::json report =
           renderReport({scene, m, config.estimator, adaptive, costSource, spp, seed, deviceName, r, reference});
@@ -231,12 +299,43 @@ int main(int argc, char** argv) {
                                  reference->source);
       std::cout << fmt::format("wrote {} and {}{}\n", out, reportPath,
                                alphaMap.empty() ? "" : fmt::format(", {} and {}", alphaMap, alphaPngPath(alphaMap)));
+    } else if (app.got_subcommand("compare")) {
+      if (suite) {
+        for (const char* sceneOption : {"--envmap", "--grid", "--envmap-sampler", "--split-brdf"})
+          if (compareCmd->count(sceneOption) > 0)
+            throw InputError(fmt::format("--suite runs its own scenes: drop {}", sceneOption));
+        if (compareCmd->count("--size") == 0) compareScene.size = "64x64";
+        Scene probe = compareScene.make();  // checks --size and --view
+        for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
+          c.scene.viewTheta = probe.options.viewTheta;
+          c.scene.viewPhi = probe.options.viewPhi;
+          compare.cases.push_back(c);
+        }
+      } else {
+        Scene probe = compareScene.make();  // reads the envmap once, so bad input fails before any work
+        compare.cases.push_back({caseLabel(probe.options), probe.options});
+      }
+      compare.methods = parseMethodList(methodList);
+      compare.budgets = parseBudgets(budgetList);
+      compare.adaptive = compareAdaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
+      validateCompareOptions(compare);
+      Comparison comparison = runComparison(compare);
+      Summary summary = summarize(comparison, compare);
+      writeCompareReport(summary, compare.outDir);
+      if (comparison.interrupted) {
+        std::cerr << fmt::format("misalloc: interrupted after {} runs; {} holds them, every file complete\n",
+                                 comparison.runs.size(), compare.outDir);
+        return 130;
+      }
+      std::cout << summaryMarkdown(summary);
+      std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n",
+                               compare.outDir);
     } else if (app.got_subcommand("reference")) {
       if (referenceSpp < 1) throw InputError("--spp must be at least 1");
       if (!referenceOut.empty()) checkWritableOutput(referenceOut, "--out");
       Scene scene = referenceScene.make();
       std::unique_ptr<Device> device;
-      auto sampler = makeSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
+      auto sampler = makeStageSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
       auto reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
       if (!referenceOut.empty()) writeExr(referenceOut, reference->image);
       std::cout << fmt::format("reference: {}{}\n", reference->source,

@@ -14,39 +14,15 @@
 #include <nlohmann/json.hpp>
 
 #include "Error.h"
+#include "CliRunner.h"
 #include "TestDevice.h"
 #include "cl/Device.h"
 #include "scene/ExrIO.h"
 
 namespace fs = std::filesystem;
 
-namespace {
-
-struct CommandResult {
-  int exitCode;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult runMisalloc(const std::string& args, const std::string& environment = "") {
-  std::string command = fmt::format("{} {} {} 2>&1", environment, MISALLOC_BINARY, args);
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
-  int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-struct TempDir {
-  fs::path path;
-  TempDir() : path(fs::temp_directory_path() / fmt::format("misalloc_cli_{}", ::getpid())) {
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
-}  // namespace
+using misalloc::test::runMisalloc;
+using misalloc::test::TempDir;
 
 TEST_CASE("render writes an image and a report", "[cli]") {
   TempDir dir;

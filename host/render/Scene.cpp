@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,14 +17,37 @@ std::vector<std::string> Scene::techniqueNames() const {
   return {"envmap", "brdf"};
 }
 
-std::string resolveEnvmapSpec(const std::string& spec) {
-  for (const char* procedural : {"constant", "cosk", "sun"})
-    if (spec == procedural || spec.rfind(std::string(procedural) + ":", 0) == 0) return spec;
-  if (fs::exists(spec) || spec.find('/') != std::string::npos || spec.find(".exr") != std::string::npos) return spec;
+namespace {
+
+// Where shipped maps are looked for, in order.
+std::vector<std::string> envmapDirs() {
   std::vector<std::string> dirs;
   if (const char* env = std::getenv("MISALLOC_DATA_DIR")) dirs.push_back(fmt::format("{}/envmaps", env));
   dirs.push_back(MISALLOC_INSTALL_DATA_DIR "/envmaps");
   dirs.push_back(MISALLOC_SOURCE_DIR "/data/envmaps");
+  return dirs;
+}
+
+}  // namespace
+
+std::vector<std::string> shippedEnvmapNames() {
+  for (const auto& dir : envmapDirs()) {
+    if (!fs::is_directory(dir)) continue;
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (entry.path().extension() == ".exr") names.push_back(entry.path().stem().string());
+    if (names.empty()) continue;
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  throw InputError(fmt::format("no shipped envmaps in {}", fmt::join(envmapDirs(), ", ")));
+}
+
+std::string resolveEnvmapSpec(const std::string& spec) {
+  for (const char* procedural : {"constant", "cosk", "sun"})
+    if (spec == procedural || spec.rfind(std::string(procedural) + ":", 0) == 0) return spec;
+  if (fs::exists(spec) || spec.find('/') != std::string::npos || spec.find(".exr") != std::string::npos) return spec;
+  const std::vector<std::string> dirs = envmapDirs();
   for (const auto& dir : dirs) {
     fs::path candidate = fs::path(dir) / (spec + ".exr");
     if (fs::exists(candidate)) return candidate.string();

@@ -41,6 +41,10 @@ Scene makeScene(const SceneOptions& options);
 // places searched when a name matches no file.
 std::string resolveEnvmapSpec(const std::string& spec);
 
+// The names of the envmaps shipped in data/envmaps (installed or in the source tree),
+// sorted.
+std::vector<std::string> shippedEnvmapNames();
+
 EnvmapSampler parseEnvmapSampler(const std::string& name);
 
 }  // namespace misalloc

@@ -1,0 +1,20 @@
+#include "compare/CompareReport.h"
+
+#include "AtomicFile.h"
+#include "compare/ErrorTimePlot.h"
+#include "compare/HtmlIndex.h"
+#include "compare/SummaryTables.h"
+
+namespace misalloc {
+
+void writeCompareReport(const Summary& summary, const std::string& outDir) {
+  writeFileAtomically(outDir + "/summary.md", summaryMarkdown(summary));
+  writeFileAtomically(outDir + "/summary.csv", summaryCsv(summary));
+  writeFileAtomically(outDir + "/summary.json", summaryJson(summary).dump(2) + "\n");
+  writeFileAtomically(outDir + "/budgets.csv", budgetsCsv(summary));
+  for (const CaseSummary& c : summary.cases)
+    writeFileAtomically(outDir + "/" + plotFileName(c.info.label), errorTimePlotSvg(c));
+  writeFileAtomically(outDir + "/index.html", indexHtml(summary));
+}
+
+}  // namespace misalloc

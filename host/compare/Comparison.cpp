@@ -1,0 +1,190 @@
+#include "compare/Comparison.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "AtomicFile.h"
+#include "Error.h"
+#include "compare/Interruption.h"
+#include "compare/ProgressMeter.h"
+#include "render/AlphaMap.h"
+#include "render/Costs.h"
+#include "render/ImageMetrics.h"
+#include "render/PreviewPng.h"
+#include "render/Reference.h"
+#include "render/Report.h"
+#include "render/SamplerChoice.h"
+
+namespace misalloc {
+namespace fs = std::filesystem;
+namespace {
+
+std::string runStem(const std::string& caseLabel, Method method, int budget) {
+  return fmt::format("{}/{}_{}spp", caseLabel, methodName(method), budget);
+}
+
+RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat, uint64_t seed, const Rendering& r,
+                    const RgbImage& reference) {
+  RunRecord rec;
+  rec.caseLabel = info.label;
+  rec.method = method;
+  rec.budget = budget;
+  rec.repeat = repeat;
+  rec.seed = seed;
+  rec.wallSeconds = r.wallSeconds;
+  rec.kernelSeconds = r.kernelSeconds;
+  rec.allocationSeconds = r.allocationSeconds;
+  rec.hostSeconds = r.hostSeconds;
+  double e = rmse(r.image, reference);
+  rec.mse = e * e;
+  rec.relativeMse = relativeMse(r.image, reference);
+  const size_t M = info.techniques.size(), pixels = r.alpha.size() / M;
+  rec.meanAlpha.assign(M, 0.0);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t k = 0; k < M; ++k) rec.meanAlpha[k] += r.alpha[p * M + k] / double(pixels);
+  rec.fallbackFraction = double(r.fallbackPixels) / double(pixels);
+  rec.flooredFraction = double(r.flooredPixels) / double(pixels);
+  rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
+  return rec;
+}
+
+nlohmann::json runJson(const RunRecord& r) {
+  return {{"case", r.caseLabel},
+          {"method", methodName(r.method)},
+          {"spp", r.budget},
+          {"repeat", r.repeat},
+          {"seed", r.seed},
+          {"time_s",
+           {{"wall", r.wallSeconds},
+            {"kernel", r.kernelSeconds},
+            {"allocation", r.allocationSeconds},
+            {"host", r.hostSeconds}}},
+          {"rmse_x1000", 1000 * std::sqrt(r.mse)},
+          {"relative_mse", r.relativeMse},
+          {"efficiency", r.efficiency()},
+          {"mean_alpha", r.meanAlpha},
+          {"fallback_pixel_fraction", r.fallbackFraction},
+          {"floored_pixel_fraction", r.flooredFraction},
+          {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel}};
+}
+
+nlohmann::json caseJson(const CaseInfo& c) {
+  return {{"label", c.label},         {"scene", c.scene},   {"techniques", c.techniques},
+          {"costs_s_per_sample", c.costs}, {"costs_source", c.costSource}, {"reference", c.referenceSource},
+          {"device", c.device}};
+}
+
+std::string runsCsv(const Comparison& comparison) {
+  std::string csv =
+      "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,relative_mse,efficiency,"
+      "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,statistics_bytes_per_pixel\n";
+  for (const RunRecord& r : comparison.runs)
+    csv += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+                       r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
+                       r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.mse), r.relativeMse, r.efficiency(),
+                       r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.statisticsBytesPerPixel);
+  return csv;
+}
+
+// Rewritten after every run, so that an interrupted comparison keeps what finished.
+void writeRuns(const std::string& outDir, const Comparison& comparison) {
+  nlohmann::json json = {{"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()},
+                         {"runs", nlohmann::json::array()}};
+  for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseJson(c));
+  for (const RunRecord& r : comparison.runs) json["runs"].push_back(runJson(r));
+  writeFileAtomically(outDir + "/runs.json", json.dump(2) + "\n");
+  writeFileAtomically(outDir + "/runs.csv", runsCsv(comparison));
+}
+
+}  // namespace
+
+std::string previewPath(const std::string& exrPath) { return fs::path(exrPath).replace_extension(".png").string(); }
+
+std::string imagePath(const std::string& caseLabel, Method method, int budget) {
+  return runStem(caseLabel, method, budget) + ".exr";
+}
+
+std::string alphaMapPath(const std::string& caseLabel, Method method, int budget) {
+  return runStem(caseLabel, method, budget) + "_alpha.exr";
+}
+
+void validateCompareOptions(const CompareOptions& options) {
+  if (options.cases.empty()) throw InputError("compare: no scene");
+  if (options.methods.empty()) throw InputError("--methods: no method");
+  if (options.budgets.empty()) throw InputError("--budgets: no budget");
+  for (size_t i = 0; i < options.budgets.size(); ++i) {
+    if (options.budgets[i] < 1) throw InputError(fmt::format("--budgets: {} is not a positive spp", options.budgets[i]));
+    if (i > 0 && options.budgets[i] <= options.budgets[i - 1])
+      throw InputError("--budgets: list each budget once, in ascending order");
+  }
+  if (options.repeats < 1) throw InputError(fmt::format("--repeats {}: need at least 1", options.repeats));
+  if (options.adaptive.gridSize < 2)
+    throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations",
+                                 options.adaptive.gridSize));
+  for (const CompareCase& c : options.cases) {
+    const int M = c.scene.splitBrdf ? 3 : 2;
+    if (!options.adaptive.costs.empty() && int(options.adaptive.costs.size()) != M)
+      throw InputError(fmt::format("--cost: {} needs {} costs", c.label, M));
+    for (Method m : options.methods) {
+      if (m == Method::Oracle && options.adaptive.oracleSamples < 2 * M)
+        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
+                                     options.adaptive.oracleSamples));
+      if (isAdaptive(m) && m != Method::Oracle)
+        for (int budget : options.budgets) stageSizes(options.adaptive.pilotFraction, options.adaptive.stages, budget, M);
+    }
+  }
+}
+
+Comparison runComparison(const CompareOptions& options) {
+  InterruptionGuard guard;
+  fs::create_directories(options.outDir);
+  const int perCase = int(options.methods.size() * options.budgets.size()) * options.repeats;
+  ProgressMeter meter(int(options.cases.size()) * perCase);
+  std::unique_ptr<Device> device;
+  Comparison out;
+  for (const CompareCase& c : options.cases) {
+    Scene scene = makeScene(c.scene);
+    fs::create_directories(fs::path(options.outDir) / c.label);
+    auto plain = makeStageSampler(options.device, device, scene, SamplerConfig{}, options.localSize);
+    meter.note(fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label,
+                           options.referenceSpp));
+    std::optional<Reference> reference = findReference(*plain, scene, options.referenceSpp, options.cacheDir, true);
+    AdaptiveOptions adaptive = options.adaptive;
+    bool measured = adaptive.costs.empty();
+    if (measured) adaptive.costs = measureCosts(*plain);
+    out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs,
+                         measured ? "measured" : "--cost", reference->source, samplerDeviceName(device)});
+    const CaseInfo& info = out.cases.back();
+    const double exposure = previewExposure(reference->image);
+    writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
+    for (Method method : options.methods)
+      for (int budget : options.budgets)
+        for (int r = 0; r < options.repeats; ++r) {
+          if (InterruptionGuard::requested()) {
+            out.interrupted = true;
+            writeRuns(options.outDir, out);
+            return out;
+          }
+          auto sampler = makeStageSampler(options.device, device, scene,
+                                          samplerConfigFor(method, Estimator::MultiSample, budget, adaptive),
+                                          options.localSize);
+          const uint64_t seed = options.seed + uint64_t(r);
+          Rendering rendering = render(*sampler, method, adaptive, budget, seed);
+          out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference->image));
+          if (r == 0) {
+            std::string image = options.outDir + "/" + imagePath(c.label, method, budget);
+            writeExr(image, rendering.image);
+            writePreviewPng(previewPath(image), rendering.image, exposure);
+            if (isAdaptive(method))
+              writeAlphaMaps(options.outDir + "/" + alphaMapPath(c.label, method, budget), scene, rendering);
+          }
+          writeRuns(options.outDir, out);
+          meter.step(fmt::format("{} {} {} spp #{}", c.label, methodName(method), budget, r + 1));
+        }
+  }
+  return out;
+}
+
+}  // namespace misalloc

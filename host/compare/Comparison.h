@@ -1,0 +1,85 @@
+#pragma once
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "render/Method.h"
+#include "render/Render.h"
+#include "render/Scene.h"
+
+namespace misalloc {
+
+// One scene of a comparison, with the label that names its column and its folder.
+struct CompareCase {
+  std::string label;
+  SceneOptions scene;
+};
+
+struct CompareOptions {
+  std::vector<CompareCase> cases;
+  std::vector<Method> methods;
+  std::vector<int> budgets;  // spp, ascending
+  int repeats = 4;           // independent seeds per (method, budget)
+  uint64_t seed = 1;         // repeat r uses seed + r
+  int tableBudget = 200;     // the spp of the Table 5.2 layout (the nearest budget)
+  AdaptiveOptions adaptive;  // costs empty: measured per case
+  std::string device = "auto";
+  int localSize = 8;
+  int referenceSpp = 16384;
+  std::string cacheDir;
+  std::string outDir;
+};
+
+// What one render measured.
+struct RunRecord {
+  std::string caseLabel;
+  Method method = Method::Equal;
+  int budget = 0;
+  int repeat = 0;
+  uint64_t seed = 0;
+  double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;
+  double mse = 0, relativeMse = 0;
+  std::vector<double> meanAlpha;  // per technique
+  double fallbackFraction = 0;    // pixels where an allocation rule fell back
+  double flooredFraction = 0;     // pixels whose counts were raised to one per technique
+  double statisticsBytesPerPixel = 0;
+
+  // 1/(MSE × time): what a method buys per second.
+  double efficiency() const { return 1.0 / (mse * wallSeconds); }
+};
+
+// What a case shares across its runs.
+struct CaseInfo {
+  std::string label;
+  nlohmann::json scene;
+  std::vector<std::string> techniques;
+  std::vector<double> costs;
+  std::string costSource;  // "measured" or "--cost"
+  std::string referenceSource;
+  std::string device;
+};
+
+struct Comparison {
+  std::vector<CaseInfo> cases;
+  std::vector<RunRecord> runs;
+  bool interrupted = false;  // runs holds only what finished
+};
+
+// Every case × method × budget × repeat, in that order. Writes each repeat-0 render's
+// image and α map (EXR + PNG) under outDir/<case>/ as it goes, and the runs so far to
+// outDir/runs.{json,csv} after each one, all atomically. Stops after the render in
+// flight when SIGINT or SIGTERM arrives (Comparison::interrupted).
+Comparison runComparison(const CompareOptions& options);
+
+// Throws InputError for a budget that some adaptive method cannot split into a pilot
+// and its stages, and for an empty or unknown list.
+void validateCompareOptions(const CompareOptions& options);
+
+// The file names of a case's repeat-0 outputs, relative to outDir.
+std::string imagePath(const std::string& caseLabel, Method method, int budget);  // .exr; .png beside
+std::string alphaMapPath(const std::string& caseLabel, Method method, int budget);
+// The sRGB preview written beside an EXR: the same path with .png.
+std::string previewPath(const std::string& exrPath);
+
+}  // namespace misalloc

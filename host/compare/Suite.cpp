@@ -1,0 +1,35 @@
+#include "compare/Suite.h"
+
+#include <cctype>
+#include <filesystem>
+
+namespace misalloc {
+
+std::string caseLabel(const SceneOptions& scene) {
+  std::string name = scene.envmap;
+  if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0)
+    name = std::filesystem::path(name).stem().string();
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
+  if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";
+  if (scene.splitBrdf) name += "-split";
+  return name;
+}
+
+std::vector<CompareCase> suiteCases(int width, int height) {
+  std::vector<CompareCase> cases;
+  SceneOptions base;
+  base.width = width;
+  base.height = height;
+  for (const std::string& map : shippedEnvmapNames()) {
+    SceneOptions o = base;
+    o.envmap = map;
+    cases.push_back({caseLabel(o), o});
+  }
+  SceneOptions cdf = base;
+  cdf.sampler = EnvmapSampler::Cdf;
+  cases.push_back({caseLabel(cdf), cdf});
+  return cases;
+}
+
+}  // namespace misalloc

@@ -1,0 +1,236 @@
+#include "compare/SummaryTables.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace misalloc {
+namespace {
+
+// Rows = methods, one column per scene; `cell` gives a scene's entry and its number
+// (lower is better when `lowerBetter`), NaN where there is none. The best entry of
+// each column is marked bold.
+template <typename Cell>
+TextTable methodTable(const Summary& s, bool lowerBetter, Cell cell) {
+  TextTable table{{"method"}, {}};
+  for (const CaseSummary& c : s.cases) table.header.push_back(c.info.label);
+  std::vector<double> best(s.cases.size(), lowerBetter ? std::numeric_limits<double>::infinity() : 0.0);
+  for (size_t i = 0; i < s.cases.size(); ++i)
+    for (Method m : s.methods) {
+      double v = cell(s.cases[i], m).second;
+      if (v == v) best[i] = lowerBetter ? std::min(best[i], v) : std::max(best[i], v);
+    }
+  for (Method m : s.methods) {
+    std::vector<TableCell> row{{methodName(m), false}};
+    for (size_t i = 0; i < s.cases.size(); ++i) {
+      auto [text, v] = cell(s.cases[i], m);
+      row.push_back({text, v == best[i]});
+    }
+    table.rows.push_back(row);
+  }
+  return table;
+}
+
+std::string escapeHtml(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+
+std::pair<std::string, double> rmseCell(const Summary& s, const CaseSummary& c, Method m) {
+  const MethodSummary* ms = c.find(m);
+  const BudgetStats* b = ms ? ms->at(s.tableBudget) : nullptr;
+  if (!b) return {"–", kNone};
+  return {fmt::format("{:.2f} ± {:.2f}", b->rmseX1000, b->rmseSpreadX1000), b->rmseX1000};
+}
+
+std::pair<std::string, double> speedUpCell(const CaseSummary& c, Method m) {
+  const MethodSummary* ms = c.find(m);
+  if (!ms || !ms->medianSpeedUp) return {"–", kNone};
+  return {fmt::format("{:.2f}×", *ms->medianSpeedUp), *ms->medianSpeedUp};
+}
+
+std::pair<std::string, double> timeCell(const Summary& s, const CaseSummary& c, Method m) {
+  const MethodSummary* ms = c.find(m);
+  const BudgetStats* b = ms ? ms->at(s.tableBudget) : nullptr;
+  if (!b) return {"–", kNone};
+  return {fmt::format("{:.3f} ({:.3f} + {:.3f})", b->wallSeconds, b->kernelSeconds, b->allocationSeconds),
+          b->wallSeconds};
+}
+
+nlohmann::json curveValueJson(const CurveValue& v) { return {{"value", v.value}, {"extrapolated", v.extrapolated}}; }
+
+nlohmann::json budgetJson(const BudgetStats& b) {
+  return {{"spp", b.budget},
+          {"repeats", b.repeats},
+          {"mse", b.mse},
+          {"rmse_x1000", b.rmseX1000},
+          {"rmse_spread_x1000", b.rmseSpreadX1000},
+          {"relative_mse", b.relativeMse},
+          {"time_s",
+           {{"wall", b.wallSeconds},
+            {"kernel", b.kernelSeconds},
+            {"allocation", b.allocationSeconds},
+            {"host", b.hostSeconds}}},
+          {"efficiency", b.efficiency},
+          {"mean_alpha", b.meanAlpha},
+          {"speed_up_over_equal", curveValueJson(b.speedUp)}};
+}
+
+}  // namespace
+
+TextTable rmseTable(const Summary& s) {
+  return methodTable(s, true, [&](const CaseSummary& c, Method m) { return rmseCell(s, c, m); });
+}
+
+TextTable speedUpTable(const Summary& s) { return methodTable(s, false, speedUpCell); }
+
+TextTable timeTable(const Summary& s) {
+  return methodTable(s, true, [&](const CaseSummary& c, Method m) { return timeCell(s, c, m); });
+}
+
+TextTable equalTimeTable(const CaseSummary& c) {
+  TextTable table{{"method"}, {}};
+  for (double t : c.commonSeconds) table.header.push_back(fmt::format("{:.3g} s", t));
+  for (const MethodSummary& m : c.methods) {
+    if (m.equalTimeRmseX1000.empty()) continue;
+    std::vector<TableCell> row{{methodName(m.method), false}};
+    for (const CurveValue& v : m.equalTimeRmseX1000) row.push_back({formatCurveValue(v, 2), false});
+    table.rows.push_back(row);
+  }
+  return table;
+}
+
+std::string markdown(const TextTable& table) {
+  std::string out = "|";
+  for (const std::string& h : table.header) out += " " + h + " |";
+  out += "\n|";
+  for (size_t i = 0; i < table.header.size(); ++i) out += "---|";
+  out += "\n";
+  for (const auto& row : table.rows) {
+    out += "|";
+    for (const TableCell& c : row) out += " " + (c.best ? "**" + c.text + "**" : c.text) + " |";
+    out += "\n";
+  }
+  return out;
+}
+
+std::string html(const TextTable& table) {
+  std::string out = "<table>\n<tr>";
+  for (const std::string& h : table.header) out += "<th>" + escapeHtml(h) + "</th>";
+  out += "</tr>\n";
+  for (const auto& row : table.rows) {
+    out += "<tr>";
+    for (const TableCell& c : row) out += c.best ? "<td><b>" + escapeHtml(c.text) + "</b></td>" : "<td>" + escapeHtml(c.text) + "</td>";
+    out += "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string formatCurveValue(const CurveValue& v, int decimals) {
+  return (v.extrapolated ? "~" : "") + fmt::format("{:.{}f}", v.value, decimals);
+}
+
+std::string summaryMarkdown(const Summary& s) {
+  const CaseSummary* first = s.cases.empty() ? nullptr : &s.cases.front();
+  std::string out = "# misalloc compare\n\n";
+  if (s.interrupted) out += "**Interrupted: the tables hold only the budgets that every repeat finished.**\n\n";
+  if (first) {
+    int repeats = 0;
+    for (const MethodSummary& m : first->methods)
+      if (!m.budgets.empty()) repeats = m.budgets.front().repeats;
+    out += fmt::format("Device: {}. Budgets (spp): {}. Repeats with independent seeds: {}.\n\n", first->info.device,
+                       fmt::join(s.budgets, ", "), repeats);
+  }
+  out += fmt::format(
+      "## RMSE×1000 at {} spp\n\nThe layout of 000 Table 5.2: the RMSE of RGB over the image against the reference, "
+      "×1000, as the mean over repeats ± their spread (sample standard deviation). Bold: the best of the column.\n\n",
+      s.tableBudget);
+  out += markdown(rmseTable(s));
+  out +=
+      "\n## Speed-up over equal at equal error\n\nHow many times longer `equal` needs to reach the error each method "
+      "reaches, in wall-clock time per render (sampling, allocation and host); the median over the budgets. Above 1: "
+      "the method pays off.\n\n";
+  out += markdown(speedUpTable(s));
+  out += fmt::format("\n## Time per render at {} spp\n\nWall seconds (sampling kernels + allocation); the rest is host "
+                     "work.\n\n",
+                     s.tableBudget);
+  out += markdown(timeTable(s));
+  out +=
+      "\n## Equal-time error per scene\n\nRMSE×1000 of each method interpolated (log–log) at equal's mean render "
+      "times; `~` marks values continued past the method's measured times with the Monte Carlo law MSE ∝ 1/t.\n";
+  for (const CaseSummary& c : s.cases) out += "\n### " + c.info.label + "\n\n" + markdown(equalTimeTable(c));
+  return out;
+}
+
+std::string summaryCsv(const Summary& s) {
+  std::string out = "method";
+  for (const CaseSummary& c : s.cases) out += "," + c.info.label;
+  out += "\n";
+  for (Method m : s.methods) {
+    out += methodName(m);
+    for (const CaseSummary& c : s.cases) {
+      const MethodSummary* ms = c.find(m);
+      const BudgetStats* b = ms ? ms->at(s.tableBudget) : nullptr;
+      out += b ? fmt::format(",{:.4f}", b->rmseX1000) : ",";
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string budgetsCsv(const Summary& s) {
+  std::string out =
+      "case,method,spp,repeats,rmse_x1000,rmse_spread_x1000,relative_mse,wall_s,kernel_s,allocation_s,host_s,"
+      "efficiency,speed_up_over_equal,speed_up_extrapolated\n";
+  for (const CaseSummary& c : s.cases)
+    for (const MethodSummary& m : c.methods)
+      for (const BudgetStats& b : m.budgets)
+        out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+                           c.info.label, methodName(m.method), b.budget, b.repeats, b.rmseX1000, b.rmseSpreadX1000,
+                           b.relativeMse, b.wallSeconds, b.kernelSeconds, b.allocationSeconds, b.hostSeconds,
+                           b.efficiency, b.speedUp.value, b.speedUp.extrapolated ? 1 : 0);
+  return out;
+}
+
+nlohmann::json summaryJson(const Summary& s) {
+  nlohmann::json cases = nlohmann::json::array();
+  for (const CaseSummary& c : s.cases) {
+    nlohmann::json methods = nlohmann::json::array();
+    for (const MethodSummary& m : c.methods) {
+      nlohmann::json budgets = nlohmann::json::array(), equalTime = nlohmann::json::array();
+      for (const BudgetStats& b : m.budgets) budgets.push_back(budgetJson(b));
+      for (const CurveValue& v : m.equalTimeRmseX1000) equalTime.push_back(curveValueJson(v));
+      methods.push_back({{"method", methodName(m.method)},
+                         {"budgets", budgets},
+                         {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
+                         {"median_speed_up_over_equal",
+                          m.medianSpeedUp ? nlohmann::json(*m.medianSpeedUp) : nlohmann::json()},
+                         {"equal_time_rmse_x1000", equalTime}});
+    }
+    cases.push_back({{"label", c.info.label},
+                     {"scene", c.info.scene},
+                     {"costs_s_per_sample", c.info.costs},
+                     {"costs_source", c.info.costSource},
+                     {"reference", c.info.referenceSource},
+                     {"device", c.info.device},
+                     {"equal_time_seconds", c.commonSeconds},
+                     {"methods", methods}});
+  }
+  nlohmann::json methods = nlohmann::json::array();
+  for (Method m : s.methods) methods.push_back(methodName(m));
+  return {{"interrupted", s.interrupted}, {"table_spp", s.tableBudget}, {"budgets", s.budgets},
+          {"methods", methods},           {"cases", cases}};
+}
+
+}  // namespace misalloc

@@ -1,0 +1,48 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "compare/Summary.h"
+
+namespace misalloc {
+
+struct TableCell {
+  std::string text;
+  bool best = false;  // the best of its column: bold
+};
+
+// A table for Markdown and HTML alike.
+struct TextTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<TableCell>> rows;
+};
+
+std::string markdown(const TextTable& table);
+std::string html(const TextTable& table);
+
+// Rows = methods, columns = scenes (000 Table 5.2): RMSE×1000 at the table budget as
+// mean ± spread; the median speed-up over equal at equal error; the time per render.
+TextTable rmseTable(const Summary& summary);
+TextTable speedUpTable(const Summary& summary);
+TextTable timeTable(const Summary& summary);
+// One scene: each method's RMSE×1000 at equal's render times (ErrorCurve::mseAt).
+TextTable equalTimeTable(const CaseSummary& scene);
+
+// The summary in the layout of 000 Table 5.2 (rows = methods, columns = scenes):
+// RMSE×1000 at the table budget, then the speed-up over equal at equal error and the
+// time per render; per scene, the equal-time errors.
+std::string summaryMarkdown(const Summary& summary);
+
+// Table 5.2 alone: method, then RMSE×1000 of each scene at the table budget.
+std::string summaryCsv(const Summary& summary);
+
+// Every (scene, method, budget) reduced over its repeats, one row each.
+std::string budgetsCsv(const Summary& summary);
+
+nlohmann::json summaryJson(const Summary& summary);
+
+// "12.3" or "~12.3" for a value continued past the measured range (ErrorCurve).
+std::string formatCurveValue(const CurveValue& v, int decimals);
+
+}  // namespace misalloc

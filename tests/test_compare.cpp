@@ -1,0 +1,225 @@
+// misalloc compare: the equal-time arithmetic on curves with known answers, the
+// reductions over repeats, and the command end to end: its files, its bad input and
+// its interruption.
+#include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <thread>
+
+#include "CliRunner.h"
+#include "compare/ErrorCurve.h"
+#include "compare/ErrorTimePlot.h"
+#include "compare/Summary.h"
+#include "compare/SummaryTables.h"
+
+using namespace misalloc;
+using misalloc::test::runMisalloc;
+using misalloc::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+// MSE = a/t: a method at constant efficiency 1/a.
+ErrorCurve monteCarloCurve(double a, std::vector<double> times) {
+  std::vector<CurvePoint> points;
+  for (double t : times) points.push_back({t, a / t});
+  return ErrorCurve(points);
+}
+
+RunRecord record(const std::string& label, Method m, int budget, int repeat, double seconds, double mse) {
+  RunRecord r;
+  r.caseLabel = label;
+  r.method = m;
+  r.budget = budget;
+  r.repeat = repeat;
+  r.wallSeconds = r.kernelSeconds = seconds;
+  r.mse = mse;
+  r.meanAlpha = {0.5, 0.5};
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("error curves interpolate in log-log and continue with the Monte Carlo law", "[compare]") {
+  ErrorCurve curve = monteCarloCurve(2.0, {0.4, 0.1, 0.2});  // unsorted on purpose
+  for (double t : {0.1, 0.13, 0.2, 0.31, 0.4}) {
+    CurveValue v = curve.mseAt(t);
+    CHECK(v.value == Approx(2.0 / t).epsilon(1e-12));
+    CHECK_FALSE(v.extrapolated);
+  }
+  for (double t : {0.05, 1.0}) {
+    CurveValue v = curve.mseAt(t);
+    CHECK(v.value == Approx(2.0 / t).epsilon(1e-12));
+    CHECK(v.extrapolated);
+  }
+  for (double mse : {5.0, 12.0, 20.0, 40.0}) CHECK(curve.secondsFor(mse).value == Approx(2.0 / mse).epsilon(1e-12));
+  CHECK_FALSE(curve.secondsFor(12.0).extrapolated);
+  CHECK(curve.secondsFor(40.0).extrapolated);
+  CHECK(*curve.logLogSlope() == Approx(-1).epsilon(1e-12));
+  ErrorCurve slower({{1, 1}, {4, 0.5}});  // MSE ∝ t^(−1/2)
+  CHECK(*slower.logLogSlope() == Approx(-0.5).epsilon(1e-12));
+  CHECK_FALSE(ErrorCurve({{1, 1}}).logLogSlope());
+  CHECK_THROWS_AS(ErrorCurve({{1, 0}}), std::invalid_argument);
+  CHECK_THROWS_AS(ErrorCurve({}), std::invalid_argument);
+}
+
+TEST_CASE("the speed-up over equal at equal error is the ratio of efficiencies under the Monte Carlo law",
+          "[compare]") {
+  ErrorCurve equal = monteCarloCurve(2.0, {0.1, 0.2, 0.4, 0.8});
+  // Half equal's error at each time: equal needs twice as long for the same error.
+  for (double t : {0.1, 0.3, 0.8}) {
+    CurveValue s = speedUpOver(equal, {t, 1.0 / t});
+    CHECK(s.value == Approx(2.0).epsilon(1e-12));
+  }
+  // A noisy curve that rises between budgets is read at its first crossing.
+  ErrorCurve noisy({{1, 4}, {2, 1}, {3, 2}, {4, 0.5}});
+  CHECK(noisy.secondsFor(1.5).value < 2);
+}
+
+TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out", "[compare]") {
+  Comparison c;
+  c.cases.push_back({"a", {}, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
+  for (int budget : {10, 20}) {
+    for (int r = 0; r < 2; ++r) {
+      // RMSE×1000 = 100 ± 10 (budget 10) and an exact 1/t law for equal.
+      double rmse = (budget == 10 ? 90 + 20 * r : 70) / 1000.0;
+      c.runs.push_back(record("a", Method::Equal, budget, r, 0.01 * budget, 1e-4 * 10 / budget));
+      c.runs.push_back(record("a", Method::Heuristic, budget, r, 0.01 * budget, rmse * rmse));
+    }
+  }
+  c.runs.push_back(record("a", Method::Exact, 10, 0, 0.1, 1e-4));  // one repeat of two
+  CompareOptions o;
+  o.methods = {Method::Equal, Method::Heuristic, Method::Exact};
+  o.budgets = {10, 20};
+  o.repeats = 2;
+  o.tableBudget = 12;
+  Summary s = summarize(c, o);
+  CHECK(s.tableBudget == 10);
+  const CaseSummary& a = s.cases.at(0);
+  const MethodSummary* h = a.find(Method::Heuristic);
+  REQUIRE(h);
+  REQUIRE(h->budgets.size() == 2);
+  CHECK(h->budgets[0].rmseX1000 == Approx(1000 * std::sqrt((0.09 * 0.09 + 0.11 * 0.11) / 2)));
+  CHECK(h->budgets[0].rmseSpreadX1000 == Approx(std::sqrt(200.0)));  // sample sd of 90 and 110
+  CHECK(h->budgets[1].rmseSpreadX1000 == Approx(0).margin(1e-9));
+  CHECK(a.find(Method::Exact)->budgets.empty());
+  CHECK(a.find(Method::Equal)->medianSpeedUp.value() == Approx(1));
+  CHECK(a.commonSeconds == std::vector<double>{0.1, 0.2});
+
+  std::string md = summaryMarkdown(s);
+  CHECK(md.find("| exact | – |") != std::string::npos);
+  CHECK(md.find("## RMSE×1000 at 10 spp") != std::string::npos);
+  CHECK(summaryCsv(s) == fmt::format("method,a\nequal,10.0000\nheuristic,{:.4f}\nexact,\n",
+                                     h->budgets[0].rmseX1000));
+  std::string svg = errorTimePlotSvg(a);
+  CHECK(svg.rfind("<svg", 0) == 0);
+  CHECK(svg.find("</svg>") != std::string::npos);
+  CHECK(std::count(svg.begin(), svg.end(), '\n') > 3);
+  size_t lines = 0;
+  for (size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++lines;
+  CHECK(lines == 2);  // equal and heuristic; exact has no finished budget
+}
+
+TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][compare]") {
+  TempDir dir("compare");
+  const fs::path out = dir.path / "out";
+  auto r = runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 "
+                                   "--methods equal,heuristic,exact,brdf --device cpu --out-dir {} --cache-dir {}",
+                                   out.string(), (dir.path / "cache").string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  for (const char* file : {"index.html", "summary.md", "summary.csv", "summary.json", "budgets.csv", "runs.json",
+                           "runs.csv", "plot_cosk_2.svg", "cosk_2/reference.png", "cosk_2/exact_20spp.exr",
+                           "cosk_2/exact_20spp.png", "cosk_2/exact_20spp_alpha.exr", "cosk_2/exact_20spp_alpha.png"})
+    CHECK(fs::exists(out / file));
+  nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
+  CHECK(runs["interrupted"] == false);
+  CHECK(runs["runs"].size() == 4 * 2 * 2);
+  CHECK(runs["cases"][0]["reference"] == "analytic (000 eq. 6.17)");
+  nlohmann::json summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+  CHECK(summary["table_spp"] == 20);
+  for (const auto& m : summary["cases"][0]["methods"]) {
+    CHECK(m["budgets"].size() == 2);
+    CHECK(m["equal_time_rmse_x1000"].size() == 2);
+  }
+  // Every file the page shows is in the folder.
+  std::ifstream in(out / "index.html");
+  std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::regex src("src=\"([^\"]+)\"");
+  int images = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), src); it != std::sregex_iterator(); ++it, ++images)
+    CHECK(fs::exists(out / (*it)[1].str()));
+  CHECK(images == 1 + 1 + 4 * 2 + 2);  // plot, reference, each method × budget, two α maps
+}
+
+TEST_CASE("compare rejects bad options before it writes anything", "[cli][compare][bad-input]") {
+  TempDir dir("compare_bad");
+  const fs::path out = dir.path / "out";
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"--budgets 0,10", "--budgets"},
+      {"--budgets 20,10", "ascending"},
+      {"--budgets 10,x", "'x' is not a number"},
+      {"--methods equal,magic", "magic"},
+      {"--methods equal,equal", "listed twice"},
+      {"--methods exact --budgets 3", "smaller than the pilot"},
+      {"--repeats 0", "--repeats 0"},
+      {"--suite --envmap forest_slope", "drop --envmap"},
+      {"--envmap /no/such.exr", "/no/such.exr"},
+      {"--cost 1", "expected 2 numbers"},
+  };
+  for (const Case& c : cases) {
+    auto r = runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10 --out-dir {} {}",
+                                     out.string(), c.args));
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+}
+
+TEST_CASE("an interrupted compare stops with every file complete", "[cli][compare]") {
+  TempDir dir("compare_interrupt");
+  const fs::path out = dir.path / "out", log = dir.path / "log.txt";
+  const std::string args = fmt::format(
+      "{} compare --envmap cosk:2 --size 16x16 --budgets 8,16,32,64,128 --repeats 8 --device cpu --out-dir {} "
+      "--cache-dir {} >{} 2>&1",
+      MISALLOC_BINARY, out.string(), (dir.path / "cache").string(), log.string());
+  pid_t pid = 0;
+  const char* argv[] = {"sh", "-c", args.c_str(), nullptr};
+  // exec, not a child shell, so that the signal reaches misalloc itself.
+  std::string execArgs = "exec " + args;
+  argv[2] = execArgs.c_str();
+  REQUIRE(posix_spawn(&pid, "/bin/sh", nullptr, nullptr, const_cast<char**>(argv), environ) == 0);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!fs::exists(out / "runs.json") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  REQUIRE(fs::exists(out / "runs.json"));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  std::ifstream logIn(log);
+  std::string output((std::istreambuf_iterator<char>(logIn)), std::istreambuf_iterator<char>());
+  INFO(output);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(output.find("interrupted after") != std::string::npos);
+  nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
+  CHECK(runs["interrupted"] == true);
+  CHECK(runs["runs"].size() < 8 * 5 * 8);
+  nlohmann::json summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+  CHECK(summary["interrupted"] == true);
+  for (const auto& entry : fs::recursive_directory_iterator(out))
+    CHECK(entry.path().string().find(".tmp") == std::string::npos);
+}
