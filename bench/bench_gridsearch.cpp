@@ -123,11 +123,16 @@ int main(int argc, char** argv) {
   bench::MedianCollector reporter("evaluations/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const int grid = makeWeightGrid(config.techniques, config.gridSize, benchCosts()).size();
-  bench::PeerTable table{fmt::format("Grid search, {}x{} pixels, M = {}, U = {}, {} samples, OpenCL device: {}",
-                                     config.size, config.size, config.techniques, grid, config.samples, device().name()),
-                         "rule",
-                         "G evaluations/s",
-                         {{"device", device().name()}, {"width", config.size}, {"height", config.size},
-                          {"techniques", config.techniques}, {"grid_u", grid}, {"samples", config.samples}}};
+  bench::PeerTable table{
+      fmt::format("Grid search, {}x{} pixels, M = {}, U = {}, {} samples, OpenCL device: {}", config.size, config.size,
+                  config.techniques, grid, config.samples, device().name()),
+      "rule",
+      "G evaluations/s",
+      {{"device", device().name()},
+       {"width", config.size},
+       {"height", config.size},
+       {"techniques", config.techniques},
+       {"grid_u", grid},
+       {"samples", config.samples}}};
   bench::finish({table.addMedians(reporter, names, 1e9)});
 }
