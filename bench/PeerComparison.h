@@ -1,18 +1,24 @@
 #pragma once
 // What every misalloc benchmark shares: an OpenCL kernel and its OpenMP C++ peer run
 // side by side in one process, their repetitions interleaved so that the load of other
-// processes drifts over both, and a closing Markdown table of medians and ratios.
+// processes drifts over both, and closing Markdown tables of medians and ratios, also
+// written as JSON by `--summary FILE.json`.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include <cmath>
 #include <functional>
+#include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "AtomicFile.h"
+
 namespace misalloc::bench {
 
-// Keeps the median of one rate counter of every benchmark.
+// Keeps the median of one counter of every benchmark.
 class MedianCollector : public benchmark::ConsoleReporter {
  public:
   explicit MedianCollector(std::string counter) : counter_(std::move(counter)) {}
@@ -40,10 +46,21 @@ inline void registerPeers(const std::string& name, std::function<void(benchmark:
         ->ReportAggregatesOnly(true);
 }
 
-// Takes the benchmark's own "--flag value" options out of argv, giving each value to
-// its setter, and returns the rest (argv[0] first) for Google Benchmark.
+// Where `--summary` writes the closing tables; empty: nowhere.
+inline std::string& summaryPath() {
+  static std::string path;
+  return path;
+}
+
+// Takes the benchmark's own "--flag value" options, and `--summary FILE.json`, out of
+// argv, giving each value to its setter, and returns the rest (argv[0] first) for
+// Google Benchmark. An unwritable summary path fails here, before any measurement.
 inline std::vector<char*> takeFlags(int argc, char** argv,
-                                    const std::map<std::string, std::function<void(const char*)>>& setters) {
+                                    std::map<std::string, std::function<void(const char*)>> setters) {
+  setters.emplace("--summary", [](const char* path) {
+    checkWritableOutput(path, "--summary");
+    summaryPath() = path;
+  });
   std::vector<char*> rest{argv[0]};
   for (int i = 1; i < argc; ++i) {
     auto setter = setters.find(argv[i]);
@@ -56,6 +73,7 @@ inline std::vector<char*> takeFlags(int argc, char** argv,
 }
 
 // Initialises Google Benchmark with interleaved repetitions (a later flag wins).
+// Its own `--benchmark_out=FILE --benchmark_out_format=json` holds every repetition.
 inline void initialize(std::vector<char*> args) {
   static char interleave[] = "--benchmark_enable_random_interleaving=true";
   args.insert(args.begin() + 1, interleave);
@@ -63,18 +81,73 @@ inline void initialize(std::vector<char*> args) {
   benchmark::Initialize(&count, args.data());
 }
 
-// One row per name: the two medians scaled by `unit` and their ratio.
-inline std::string ratioTable(const MedianCollector& collector, const std::vector<std::string>& names,
-                              const std::string& firstColumn, const std::string& unitName, double unit) {
-  std::string table = fmt::format("| {} | OpenCL {} | OpenMP {} | ratio |\n|---|---|---|---|\n", firstColumn,
-                                  unitName, unitName);
-  for (const auto& name : names) {
-    auto cl = collector.medians.find("opencl/" + name), mp = collector.medians.find("openmp/" + name);
-    if (cl == collector.medians.end() || mp == collector.medians.end()) continue;
-    table += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} |\n", name, cl->second / unit, mp->second / unit,
-                         cl->second / mp->second);
+// One closing table: a row per name with both peers' medians in `unitName`, and their
+// ratio OpenCL / OpenMP (above 1: OpenCL has the larger value, which for a time is the
+// slower). `ratios` false for rows whose ratio means nothing, such as fitted slopes.
+struct PeerTable {
+  struct Row {
+    std::string name;
+    double openCl = 0, openMp = 0;
+  };
+  std::string title;        // what was measured, the sizes and the device
+  std::string firstColumn;  // what the row names are
+  std::string unitName;
+  nlohmann::json config;  // device name and sizes, for the summary
+  bool ratios = true;
+  std::vector<Row> rows;
+
+  // Appends a row for every name both peers have a median of, the counter's values
+  // divided by `unit` (the counter's value of one `unitName`).
+  PeerTable& addMedians(const MedianCollector& collector, const std::vector<std::string>& names, double unit) {
+    for (const auto& name : names) {
+      auto cl = collector.medians.find("opencl/" + name), mp = collector.medians.find("openmp/" + name);
+      if (cl != collector.medians.end() && mp != collector.medians.end())
+        rows.push_back({name, cl->second / unit, mp->second / unit});
+    }
+    return *this;
   }
-  return table;
+
+  // Three significant digits, without an exponent for large values.
+  static std::string formatValue(double v) {
+    return std::abs(v) < 1000 ? fmt::format("{:.3g}", v) : fmt::format("{:.0f}", v);
+  }
+
+  std::string markdown() const {
+    std::string table = fmt::format("{}\n\n| {} | OpenCL {} | OpenMP {} |{}\n|---|---|---|{}\n", title, firstColumn,
+                                    unitName, unitName, ratios ? " ratio |" : "", ratios ? "---|" : "");
+    for (const Row& r : rows)
+      table += fmt::format("| {} | {} | {} |{}\n", r.name, formatValue(r.openCl), formatValue(r.openMp),
+                           ratios ? fmt::format(" {:.2f} |", r.openCl / r.openMp) : "");
+    return table;
+  }
+
+  nlohmann::json json() const {
+    nlohmann::json out = {{"title", title}, {"config", config}, {"rows", nlohmann::json::array()}};
+    for (const Row& r : rows) {
+      nlohmann::json row = {{"name", r.name}, {"opencl", r.openCl}, {"openmp", r.openMp}, {"unit", unitName}};
+      if (ratios) row["ratio"] = r.openCl / r.openMp;  // OpenCL / OpenMP
+      out["rows"].push_back(row);
+    }
+    return out;
+  }
+};
+
+// With `--summary`, writes {"tables": tables} there, all at once.
+inline void writeSummary(const nlohmann::json& tables) {
+  if (!summaryPath().empty()) writeFileAtomically(summaryPath(), nlohmann::json{{"tables", tables}}.dump(2) + "\n");
+}
+
+// Prints the tables in Markdown, writes them to the summary
+// ({"tables": [{title, config, rows: [{name, opencl, openmp, unit, ratio}]}]}) and
+// shuts Google Benchmark down.
+inline void finish(const std::vector<PeerTable>& tables) {
+  nlohmann::json summary = nlohmann::json::array();
+  for (const PeerTable& t : tables) {
+    std::cout << "\n" << t.markdown();
+    summary.push_back(t.json());
+  }
+  writeSummary(summary);
+  benchmark::Shutdown();
 }
 
 }  // namespace misalloc::bench

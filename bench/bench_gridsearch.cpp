@@ -122,10 +122,17 @@ int main(int argc, char** argv) {
   }
   bench::MedianCollector reporter("evaluations/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  std::cout << fmt::format("\nGrid search, {}x{} pixels, M = {}, U = {}, {} samples, OpenCL device: {}\n\n",
-                           config.size, config.size, config.techniques,
-                           makeWeightGrid(config.techniques, config.gridSize, benchCosts()).size(), config.samples,
-                           device().name())
-            << bench::ratioTable(reporter, names, "rule", "G evaluations/s", 1e9);
-  benchmark::Shutdown();
+  const int grid = makeWeightGrid(config.techniques, config.gridSize, benchCosts()).size();
+  bench::PeerTable table{
+      fmt::format("Grid search, {}x{} pixels, M = {}, U = {}, {} samples, OpenCL device: {}", config.size, config.size,
+                  config.techniques, grid, config.samples, device().name()),
+      "rule",
+      "G evaluations/s",
+      {{"device", device().name()},
+       {"width", config.size},
+       {"height", config.size},
+       {"techniques", config.techniques},
+       {"grid_u", grid},
+       {"samples", config.samples}}};
+  bench::finish({table.addMedians(reporter, names, 1e9)});
 }

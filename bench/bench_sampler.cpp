@@ -2,13 +2,13 @@
 // an OpenCL device (PoCL by default) side by side, in one run, with its OpenMP C++
 // peer (HostSampler: the same estimator compiled by g++ -O3 -march=native).
 //
-//   build/bench/misalloc_bench [--device cpu] [--size 256] [--spp 64] [google benchmark flags]
+//   build/bench/misalloc_bench [--device cpu] [--size 256] [--spp 64] [--summary FILE.json]
+//                              [google benchmark flags]
 //
-// Ends with a Markdown table of medians and the PoCL/OpenMP ratio.
+// Ends with a Markdown table of medians and the OpenCL/OpenMP ratio.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include <iostream>
 #include <memory>
 
 #include "PeerComparison.h"
@@ -88,8 +88,11 @@ int main(int argc, char** argv) {
   }
   bench::MedianCollector reporter("samples/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  std::cout << fmt::format("\nSampling, {}x{} pixels, {} spp, OpenCL device: {}\n\n", config.size, config.size,
-                           config.spp, device().name())
-            << bench::ratioTable(reporter, names, "technique", "Msample/s", 1e6);
-  benchmark::Shutdown();
+  bench::PeerTable table{
+      fmt::format("Sampling, {}x{} pixels, {} spp, OpenCL device: {}", config.size, config.size, config.spp,
+                  device().name()),
+      "technique",
+      "Msample/s",
+      {{"device", device().name()}, {"width", config.size}, {"height", config.size}, {"spp", config.spp}}};
+  bench::finish({table.addMedians(reporter, names, 1e6)});
 }
