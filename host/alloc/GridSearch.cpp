@@ -84,6 +84,13 @@ int closestResolution(int techniqueCount, int approximateSize) {
 // The grid size rounded up to whole passes.
 int paddedGridSize(int gridSize) { return (gridSize + kPass - 1) / kPass * kPass; }
 
+// Floats of running sums per pixel: Σ g and Σ g² for every technique and combination
+// of the grid makeWeightGrid makes (and validates), padded to whole passes.
+std::size_t runningSumFloats(int techniqueCount, int gridSize) {
+  int size = makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0)).size();
+  return std::size_t(2) * techniqueCount * paddedGridSize(size);
+}
+
 // The grid as the passes read it: α_{k,l} at [k · paddedSize + l] and the cost per
 // sample at [l], the size rounded up to whole passes with copies of the last
 // combination, which are summed but never selected.
@@ -248,10 +255,7 @@ std::size_t StoredSampleLayout::floatCount() const {
 }
 
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize) {
-  checkTechniqueCount(techniqueCount);
-  int padded =
-      paddedGridSize(makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0)).size());
-  return std::size_t(2) * techniqueCount * padded * sizeof(float) + sizeof(kern::PixelSummary);
+  return runningSumFloats(techniqueCount, gridSize) * sizeof(float) + sizeof(kern::PixelSummary);
 }
 
 int GridSearchResult::fallbackCount() const {
@@ -261,8 +265,7 @@ int GridSearchResult::fallbackCount() const {
 
 GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize)
     : device_(device), techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
-  std::vector<double> unitCosts(techniqueCount, 1.0);
-  const int padded = paddedGridSize(makeWeightGrid(techniqueCount, gridSize, unitCosts).size());
+  const std::size_t sumFloats = runningSumFloats(techniqueCount, gridSize);
   cl::Program program =
       buildProgram(device, "gridsearch.cl",
                    fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors));
@@ -272,14 +275,14 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
   summaries_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(kern::PixelSummary));
   // Only pixels with hasSums read their sums, so reset() leaves them; they are written
   // once here so that the first search does not pay a page fault per 4 KiB of them.
-  const std::size_t sumBytes = pixels * 2 * techniqueCount * padded * sizeof(float);
+  const std::size_t sumBytes = pixels * sumFloats * sizeof(float);
   sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
   device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
   reset();
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a search of no samples, not inside the first timed one.
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
-  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, unitCosts);
+  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, std::vector<double>(techniqueCount, 1.0));
 }
 
 void GridSearch::reset() {
@@ -361,10 +364,8 @@ struct GridSearchReference::RunningSums {
 
 GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize)
     : techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
-  const int padded =
-      paddedGridSize(makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0)).size());
   running_ = std::make_unique<RunningSums>();
-  running_->sums.resize(std::size_t(std::max(0, pixelCount)) * 2 * techniqueCount * padded);
+  running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(techniqueCount, gridSize));
   reset();
 }
 
