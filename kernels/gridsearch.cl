@@ -100,6 +100,7 @@ MA_FN void loadSums(__global const float* sums, int j, int l0, int paddedSize, f
   }
 }
 
+// The sums back where loadSums found them, for the next search.
 MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const float16* sumG, const float16* sumG2) {
   for (int v = 0; v < MA_GRID_VECTORS; ++v) {
     vstore16(sumG[v], v, sums + runningSumIndex(0, j, 0, l0, MA_TECHNIQUES, paddedSize));
