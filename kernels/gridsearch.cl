@@ -1,6 +1,7 @@
 // 000 Algorithm 1, lines 5–13, for every pixel at once: one work-item per block of 16
-// pixels searches the U weight combinations, 16 of them per float16, over the samples
-// that kernels/sample.cl stored (kernels/stats.h, storedSampleIndex). Host side and C++
+// pixels adds the samples that kernels/sample.cl stored since the previous search
+// (kernels/stats.h, storedSampleIndex) to the pixel's running sums for the U weight
+// combinations, 16 of them per float16, and selects from the sums. Host side and C++
 // reference: host/alloc/GridSearch.h. What both share: kernels/gridsearch.h.
 //
 // Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M) and
@@ -12,20 +13,24 @@
 // copied once grouped by technique, are read without tests. A division has the same
 // throughput per lane at 512 and 256 bits, so the B quotients f/p_α of one sample
 // share one (MA_BATCH_QUOTIENTS), leaving multiplies, and 2B independent accumulator
-// chains. Sums are float: the scaling keeps g ≤ 1/min α, and summing a few hundred
-// samples in order loses ~√n ulps, far below the sampling noise of the estimates.
+// chains. Sums are float: the scaling keeps g < 4/min α, and summing a few hundred
+// samples in order loses ~√n ulps, far below the sampling noise of the estimates;
+// carried from search to search, they are the same sums in the same order.
 #include "gridsearch.h"
 
 #define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
 
-// Σ g and Σ g² over technique j's n prepared samples (prepareSample) for the
+// Adds g and g² of technique j's n prepared samples (prepareSample) to its sums for the
 // combinations l0 … l0 + MA_PASS − 1 (000 Alg. 1 line 8; eq. 6.6 and 6.8 before dividing
 // by m_j). alpha[v][k] holds α_k of the 16 combinations of vector v.
 MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
                         float16* sumG, float16* sumG2) {
   float16 s[MA_GRID_VECTORS], s2[MA_GRID_VECTORS];
   MA_UNROLL
-  for (int v = 0; v < MA_GRID_VECTORS; ++v) s[v] = s2[v] = 0.0f;
+  for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+    s[v] = sumG[v];
+    s2[v] = sumG2[v];
+  }
   for (int i = 0; i < n; ++i) {
     __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
     float16 p[MA_GRID_VECTORS], g[MA_GRID_VECTORS];
@@ -80,13 +85,39 @@ MA_FN int bestIndex(LaneBest best) {
   return l;
 }
 
-// 000 Alg. 1 lines 5–13 for one pixel whose prepared samples are at `prepared`.
-// Returns l₀, or −1 if no combination could be ranked. Rule (b) scores 16 combinations
-// per float16; rule (a) takes its logarithms one combination at a time.
-MA_FN int searchPixel(__global const float* prepared, PixelSummary summary, __global const float* gridLanes,
-                      __global const float* gridCost, int gridSize, int paddedSize, const float* cost, int rule) {
+// The running sums of the combinations l0 … l0 + MA_PASS − 1 of technique j, at
+// `sums` = the pixel's first, brought to the current scale (sumsRescale; 0: none yet).
+MA_FN void loadSums(__global const float* sums, int j, int l0, int paddedSize, float rescale, float16* sumG,
+                    float16* sumG2) {
+  __global const float* s = sums + runningSumIndex(0, j, 0, l0, MA_TECHNIQUES, paddedSize);
+  __global const float* s2 = sums + runningSumIndex(0, j, 1, l0, MA_TECHNIQUES, paddedSize);
+  for (int v = 0; v < MA_GRID_VECTORS; ++v) sumG[v] = sumG2[v] = 0.0f;
+  if (rescale == 0.0f) return;
+  float rescale2 = rescale * rescale;
+  for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+    sumG[v] = vload16(v, s) * rescale;
+    sumG2[v] = vload16(v, s2) * rescale2;
+  }
+}
+
+// The sums back where loadSums found them, for the next search.
+MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const float16* sumG, const float16* sumG2) {
+  for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+    vstore16(sumG[v], v, sums + runningSumIndex(0, j, 0, l0, MA_TECHNIQUES, paddedSize));
+    vstore16(sumG2[v], v, sums + runningSumIndex(0, j, 1, l0, MA_TECHNIQUES, paddedSize));
+  }
+}
+
+// 000 Alg. 1 lines 5–13 for one pixel: adds the samples prepared at `prepared`
+// (summarised in `added`) to its running sums at `sums`, and, if `rank`, returns the
+// best l₀ by the sums of all its samples (summarised in `all`), or −1 if no
+// combination could be ranked. Rule (b) scores 16 combinations per float16; rule (a)
+// takes its logarithms one combination at a time.
+MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelSummary all, float rescale,
+                      __global float* sums, int rank, __global const float* gridLanes, __global const float* gridCost,
+                      int gridSize, int paddedSize, const float* cost, int rule) {
   float invCount[MA_TECHNIQUES];
-  for (int j = 0; j < MA_TECHNIQUES; ++j) invCount[j] = 1.0f / summary.count[j];
+  for (int j = 0; j < MA_TECHNIQUES; ++j) invCount[j] = 1.0f / all.count[j];
   const int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   LaneBest best = {(float16)(-INFINITY), (int16)(-1)};
   for (int l0 = 0; l0 < gridSize; l0 += MA_PASS) {
@@ -94,9 +125,13 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary summary, __gl
     for (int v = 0; v < MA_GRID_VECTORS; ++v)
       for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[v][k] = vload16(0, gridLanes + k * paddedSize + l0 + 16 * v);
     float16 sumG[MA_TECHNIQUES][MA_GRID_VECTORS], sumG2[MA_TECHNIQUES][MA_GRID_VECTORS];
-    for (int j = 0; j < MA_TECHNIQUES; ++j)
-      sumTechnique(prepared + preparedFirst(summary, j) * (MA_TECHNIQUES + 1), summary.nonZero[j], alpha, sumG[j],
+    for (int j = 0; j < MA_TECHNIQUES; ++j) {
+      loadSums(sums, j, l0, paddedSize, rescale, sumG[j], sumG2[j]);
+      sumTechnique(prepared + preparedFirst(added, j) * (MA_TECHNIQUES + 1), added.nonZero[j], alpha, sumG[j],
                    sumG2[j]);
+      storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
+    }
+    if (!rank) continue;
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       float16 g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
       for (int j = 0; j < MA_TECHNIQUES; ++j) {
@@ -131,54 +166,64 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary summary, __gl
   return bestIndex(best);
 }
 
-// One work-item per block of 16 pixels. gridLanes[k · paddedSize + l] = α_{k,l} and
-// gridCost[l] = Σ_k c_k α_{k,l}, both padded past gridSize with the last combination;
-// cost[k] = c_k; `prepared` has taken · (M + 1) floats per pixel (prepareSample).
-// Outputs per pixel: α (M floats), the selected index l₀ (−1 where the pixel fell
-// back to equal weights) and AllocationFallback bits.
+// One work-item per block of 16 pixels. `taken` samples per pixel are new since the
+// previous search; `summaries` (per pixel) and `sums` (runningSumIndex) hold what the
+// searches before added. gridLanes[k · paddedSize + l] = α_{k,l} and gridCost[l] =
+// Σ_k c_k α_{k,l}, both padded past gridSize with the last combination; cost[k] = c_k;
+// `prepared` has taken · (M + 1) floats per pixel (prepareSample). Outputs per pixel: α
+// (M floats), the selected index l₀ (−1 where the pixel fell back to equal weights) and
+// AllocationFallback bits.
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
                          __global const float* gridLanes, __global const float* gridCost, int gridSize, int paddedSize,
-                         __global const float* cost, int rule, __global float* prepared, __global float* alphaOut,
+                         __global const float* cost, int rule, __global float* prepared,
+                         __global PixelSummary* summaries, __global float* sums, __global float* alphaOut,
                          __global int* selectedOut, __global uint* fallbacksOut) {
   int block = (int)get_global_id(0);
   if (16 * block >= pixelCount) return;
+  const int lanesUsed = min(16, pixelCount - 16 * block);
   __global const float* blockSamples = samples + (size_t)block * capacity * (MA_TECHNIQUES + 2) * 16;
   __global float* blockPrepared = prepared + (size_t)block * 16 * taken * (MA_TECHNIQUES + 1);
   // Lane-innermost passes over the samples read each row of 16 pixels once.
-  PixelSummary summary[16];
-  for (int lane = 0; lane < 16; ++lane) summary[lane] = emptySummary();
+  PixelSummary added[16];
+  for (int lane = 0; lane < 16; ++lane) added[lane] = emptySummary();
   for (int i = 0; i < taken; ++i)
-    for (int lane = 0; lane < 16; ++lane) summariseSample(&summary[lane], blockSamples + lane, MA_TECHNIQUES, i);
+    for (int lane = 0; lane < 16; ++lane) summariseSample(&added[lane], blockSamples + lane, MA_TECHNIQUES, i);
+  PixelSummary all[16];
   uint fallbacks[16];
   int next[16][MA_TECHNIQUES];
-  float scale[16];
-  for (int lane = 0; lane < 16; ++lane) {
-    fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, summary[lane]);
-    scale[lane] = sampleScale(summary[lane]);
-    for (int j = 0; j < MA_TECHNIQUES; ++j) next[lane][j] = preparedFirst(summary[lane], j);
+  float scale[16], rescale[16];
+  for (int lane = 0; lane < lanesUsed; ++lane) {
+    PixelSummary before = summaries[16 * block + lane];
+    all[lane] = mergeSummaries(before, added[lane]);
+    fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, all[lane]);
+    scale[lane] = sampleScale(all[lane]);
+    rescale[lane] = sumsRescale(before, scale[lane]);
+    for (int j = 0; j < MA_TECHNIQUES; ++j) next[lane][j] = preparedFirst(added[lane], j);
   }
   for (int i = 0; i < taken; ++i)
-    for (int lane = 0; lane < 16; ++lane)
-      if (fallbacks[lane] == 0u)
+    for (int lane = 0; lane < lanesUsed; ++lane)
+      if (hasSums(all[lane]))
         prepareSample(blockSamples + lane, MA_TECHNIQUES, i, scale[lane], next[lane],
                       blockPrepared + lane * taken * (MA_TECHNIQUES + 1));
 
   float c[MA_TECHNIQUES];
   for (int k = 0; k < MA_TECHNIQUES; ++k) c[k] = cost[k];
-  for (int lane = 0; lane < 16 && 16 * block + lane < pixelCount; ++lane) {
+  for (int lane = 0; lane < lanesUsed; ++lane) {
     int pixel = 16 * block + lane, best = -1;
-    if (fallbacks[lane] == 0u) {
-      best = searchPixel(blockPrepared + lane * taken * (MA_TECHNIQUES + 1), summary[lane], gridLanes, gridCost,
-                         gridSize, paddedSize, c, rule);
-      // No combination could be ranked: non-finite sums, or for rule (a) no λ that
-      // is a distribution (eq. 4.16 has no solution on the grid).
-      if (best < 0)
-        fallbacks[lane] = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
-    }
+    // Pixels that cannot be ranked yet keep their sums for the searches to come.
+    if (hasSums(all[lane]))
+      best = searchPixel(blockPrepared + lane * taken * (MA_TECHNIQUES + 1), added[lane], all[lane], rescale[lane],
+                         sums + runningSumIndex(pixel, 0, 0, 0, MA_TECHNIQUES, paddedSize), fallbacks[lane] == 0u,
+                         gridLanes, gridCost, gridSize, paddedSize, c, rule);
+    // No combination could be ranked: non-finite sums, or for rule (a) no λ that
+    // is a distribution (eq. 4.16 has no solution on the grid).
+    if (fallbacks[lane] == 0u && best < 0)
+      fallbacks[lane] = rule == MA_RULE_MAX_ENTROPY ? MA_FALLBACK_SINGULAR_SYSTEM : MA_FALLBACK_NON_FINITE;
     for (int k = 0; k < MA_TECHNIQUES; ++k)
       alphaOut[pixel * MA_TECHNIQUES + k] =
           fallbacks[lane] == 0u ? gridLanes[k * paddedSize + best] : 1.0f / MA_TECHNIQUES;
     selectedOut[pixel] = fallbacks[lane] == 0u ? best : -1;
     fallbacksOut[pixel] = fallbacks[lane];
+    summaries[pixel] = all[lane];
   }
 }

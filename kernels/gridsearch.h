@@ -3,6 +3,10 @@
 // share, so that both compute bit for bit the same sums and rank the weight
 // combinations with the same code. Only the loop over samples × combinations is each
 // side's own: float16 over 16 combinations in the kernel, plain loops in C++.
+//
+// The sums over a pixel's samples are running sums: the grid α_l is fixed and a
+// sample's g = f/p_α never changes, so each search adds only the samples taken since
+// the previous one, and the pixel's summary (PixelSummary) carries over with them.
 #ifndef MA_GRIDSEARCH_H
 #define MA_GRIDSEARCH_H
 #include "fastmath.h"
@@ -35,8 +39,9 @@ MA_FN float inversePowerOfTwo(float x) {
 }
 
 // What decides whether a pixel can be searched (pixelFallbacks), gathered one sample at
-// a time (summariseSample): the kernel interleaves 16 pixels' samples, so that it
-// reads every cache line of the blocked layout once.
+// a time (summariseSample) and kept from search to search (mergeSummaries): the kernel
+// interleaves 16 pixels' samples, so that it reads every cache line of the blocked
+// layout once.
 typedef struct {
   float count[MA_GRID_MAX_TECHNIQUES];  // m_j
   int nonZero[MA_GRID_MAX_TECHNIQUES];  // technique j's samples with f > 0; 0: silent
@@ -55,6 +60,17 @@ MA_FN PixelSummary emptySummary(void) {
   s.maxRatio = 0.0f;
   s.invalid = 0;
   return s;
+}
+
+// The summary of the samples of `a` and `b` together.
+MA_FN PixelSummary mergeSummaries(PixelSummary a, PixelSummary b) {
+  for (int j = 0; j < MA_GRID_MAX_TECHNIQUES; ++j) {
+    a.count[j] += b.count[j];
+    a.nonZero[j] += b.nonZero[j];
+  }
+  a.maxRatio = ma_max(a.maxRatio, b.maxRatio);
+  a.invalid |= b.invalid;
+  return a;
 }
 
 MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples, int techniqueCount, int i) {
@@ -78,9 +94,30 @@ MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples,
   s->maxRatio = ma_max(s->maxRatio, pSum > 0.0f ? f / pSum : 0.0f);
 }
 
-// The scale of g: since p_α ≥ (min_k α_k) Σ_k p_k, every scaled g = scale · f / p_α
-// is at most 1 / min_k α_k, so float sums of g² cannot overflow.
-MA_FN float sampleScale(PixelSummary s) { return s.maxRatio > 0.0f ? 1.0f / s.maxRatio : 1.0f; }
+// The scale of g: since p_α ≥ (min_k α_k) Σ_k p_k and scale · max_i f_i/Σ_k p_k < 4
+// (2 but where inversePowerOfTwo clamps), every scaled g = scale · f / p_α is below
+// 4 / min_k α_k, so float sums of g² cannot overflow. A power of two, so that sums
+// taken at one scale convert exactly to the next (sumsRescale).
+MA_FN float sampleScale(PixelSummary s) { return s.maxRatio > 0.0f ? inversePowerOfTwo(s.maxRatio) : 1.0f; }
+
+// A pixel keeps running sums once a valid sample has f > 0: until then they are all 0,
+// and after an invalid sample it falls back for good.
+MA_FN int hasSums(PixelSummary s) { return !s.invalid && s.maxRatio > 0.0f; }
+
+// The factor that takes Σ g from the scale of the samples summarised in `before` to
+// `scale` (its square takes Σ g²), or 0 where there are no sums yet. Both scales are
+// powers of two and the scale only falls as max_i f_i/Σ_k p_k grows, so the factor is
+// a power of two ≤ 1: exact, unless old sums underflow against a sample up to 2^126
+// times larger, where they no longer count.
+MA_FN float sumsRescale(PixelSummary before, float scale) {
+  return hasSums(before) ? scale / sampleScale(before) : 0.0f;
+}
+
+// Where Σ g (moment 0) and Σ g² (moment 1) of technique j's samples at combination l
+// are kept: per pixel 2M rows of paddedSize floats.
+MA_FN size_t runningSumIndex(int pixel, int j, int moment, int l, int techniqueCount, int paddedSize) {
+  return (((size_t)pixel * techniqueCount + j) * 2 + moment) * paddedSize + l;
+}
 
 // Why a pixel cannot be searched; every reason gives equal weights. A variance
 // estimate needs m_j ≥ 2. A technique whose samples all have f = 0 has μ_j = ν_j = 0:

@@ -65,7 +65,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
     __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
     int pixelCount, __global ma_acc* estimate, __global ma_acc* moments, __global ma_acc* stats,
-    __global float* samples, int samplesBefore, int sampleCapacity) {
+    __global float* samples, int firstSlot, int sampleCapacity) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
@@ -96,7 +96,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       running[s][lid] += c.technique == s / perTechnique ? statValue(MA_STATS, s % perTechnique, c) : 0;
     }
     if (MA_STORE_SAMPLES && gid < pixelCount) {
-      int i = samplesBefore + j;
+      int i = firstSlot + j;
       samples[storedSampleIndex(pixel, i, 0, sampleCapacity, MA_TECHNIQUES)] = (float)c.technique;
       samples[storedSampleIndex(pixel, i, 1, sampleCapacity, MA_TECHNIQUES)] = c.y;
       MA_UNROLL

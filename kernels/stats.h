@@ -41,10 +41,12 @@ MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
   return value;
 }
 
-// Stored samples for the allocations that need every sample (exact, linear with
-// 003 eq. 19), blocked by 16 pixels for float16 loads (kernels/gridsearch.cl):
-// value q of the pixel's sample i is at ((block·capacity + i)(M + 2) + q)·16 + lane, with
-// q = 0 the technique, 1 the luminance f, 2 + l the pdf p_l.
+// Stored samples for the allocations that need every sample: linear with 003 eq. 19
+// keeps them all; the grid searches of exact and oracle (kernels/gridsearch.cl) keep
+// running sums and need only those taken since the previous search. Blocked by 16
+// pixels for float16 loads: value q of the pixel's sample in slot i is at
+// ((block·capacity + i)(M + 2) + q)·16 + lane, with q = 0 the technique, 1 the
+// luminance f, 2 + l the pdf p_l.
 MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int techniqueCount) {
   return (((pixel / 16) * capacity + i) * (techniqueCount + 2) + q) * 16 + pixel % 16;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "KernelCode.h"
@@ -53,11 +54,18 @@ StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, int tech
   return StoredSampleLayout{int(pixels.size()), techniqueCount, capacity, int(pixels.front().size())};
 }
 
-GridSearch& deviceSearch(int techniqueCount) {
-  static std::map<int, std::unique_ptr<GridSearch>> searches;
-  auto& search = searches[techniqueCount];
-  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount);
+// One search object per shape, reset before each use: building one compiles the kernel.
+GridSearch& deviceSearch(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize) {
+  static std::map<std::tuple<int, int, int>, std::unique_ptr<GridSearch>> searches;
+  auto& search = searches[{techniqueCount, pixelCount, gridSize}];
+  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount, pixelCount, gridSize);
+  search->reset();
   return *search;
+}
+
+cl::Buffer deviceBuffer(std::vector<float>& samples) {
+  return cl::Buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
+                    samples.data());
 }
 
 struct BothResults {
@@ -68,10 +76,28 @@ BothResults searchBoth(const std::vector<PixelSampleList>& pixels, int technique
                        GridRule rule, int gridSize = kDefaultGridSize, int capacity = 0) {
   StoredSampleLayout layout = layoutOf(pixels, techniqueCount, std::max(capacity, int(pixels.front().size())));
   std::vector<float> samples = store(pixels, layout);
-  cl::Buffer buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
-                    samples.data());
-  return {deviceSearch(techniqueCount).run(buffer, layout, costs, gridSize, rule),
-          gridSearchReference(samples, layout, costs, gridSize, rule)};
+  GridSearchReference reference(techniqueCount, layout.pixelCount, gridSize);
+  return {deviceSearch(techniqueCount, layout.pixelCount, gridSize).run(deviceBuffer(samples), layout, costs, rule),
+          reference.run(samples, layout, costs, rule)};
+}
+
+// The same samples added in stages of `stageSize`, one search after each, as
+// host/render/Render.cpp runs them: the results of the last search.
+BothResults searchInStages(const std::vector<PixelSampleList>& pixels, int techniqueCount,
+                           const std::vector<double>& costs, GridRule rule, int stageSize) {
+  const int pixelCount = int(pixels.size()), total = int(pixels.front().size());
+  GridSearch& device = deviceSearch(techniqueCount, pixelCount);
+  GridSearchReference reference(techniqueCount, pixelCount);
+  BothResults r;
+  for (int first = 0; first < total; first += stageSize) {
+    std::vector<PixelSampleList> stage(pixelCount);
+    for (int p = 0; p < pixelCount; ++p)
+      stage[p].assign(pixels[p].begin() + first, pixels[p].begin() + std::min(total, first + stageSize));
+    StoredSampleLayout layout = layoutOf(stage, techniqueCount, stageSize);
+    std::vector<float> samples = store(stage, layout);
+    r = {device.run(deviceBuffer(samples), layout, costs, rule), reference.run(samples, layout, costs, rule)};
+  }
+  return r;
 }
 
 // Techniques on [0, 1] with pdfs p_0 = 1, p_1 = 2x, p_2 = 3x², sampled by inversion.
@@ -279,21 +305,57 @@ TEST_CASE("pixels the grid cannot rank fall back to equal weights", "[exact]") {
   }
 }
 
-TEST_CASE("a layout that does not match the samples is rejected", "[exact]") {
+TEST_CASE("searching stage by stage selects what one search over all the samples selects", "[exact]") {
+  // The sums run over the same samples in the same order, and the scale of g moves by
+  // powers of two only, so the running sums are bit for bit those of one search. The
+  // random pixels' largest f/Σp grows from stage to stage (rescaled sums); a few more
+  // change their fallbacks between stages.
+  for (int m : {2, 3}) {
+    std::vector<PixelSampleList> pixels = randomPixels(m, 300, 120, 31 + m);
+    for (Sample& s : pixels[0]) s.technique = &s - pixels[0].data() < 40 ? 0 : s.technique;  // too few, then enough
+    for (Sample& s : pixels[1]) s.f = &s - pixels[1].data() < 40 ? 0.0f : s.f;               // no signal, then signal
+    pixels[2][50].f = std::numeric_limits<float>::quiet_NaN();  // non-finite from stage 2 on
+    for (Sample& s : pixels[3])  // a sample in the last stage that dwarfs the ones before
+      if (&s - pixels[3].data() >= 80 && s.f > 0.0f) {
+        s.f *= 1e12f;
+        break;
+      }
+    std::vector<double> costs(m, 1.0);
+    costs[1] = 2.5;
+    for (GridRule rule : {GridRule::MinCostVariance, GridRule::MaxEntropy}) {
+      BothResults once = searchBoth(pixels, m, costs, rule), staged = searchInStages(pixels, m, costs, rule, 40);
+      INFO(fmt::format("M = {}, rule {}", m, int(rule)));
+      CHECK(staged.reference.selected == once.reference.selected);
+      CHECK(staged.device.selected == once.device.selected);
+      CHECK(staged.device.selected == staged.reference.selected);
+      for (int p = 0; p < int(pixels.size()); ++p) {
+        CHECK(staged.reference.allocations[p].fallbacks == once.reference.allocations[p].fallbacks);
+        CHECK(staged.device.allocations[p].fallbacks == once.device.allocations[p].fallbacks);
+      }
+      CHECK((staged.reference.allocations[0].fallbacks & kFallbackTooFewSamples) == 0);
+      CHECK((staged.reference.allocations[1].fallbacks & kFallbackNoSignal) == 0);
+      CHECK(staged.reference.allocations[2].fallbacks == kFallbackNonFinite);
+    }
+  }
+}
+
+TEST_CASE("a layout that does not match the samples or the search is rejected", "[exact]") {
   std::vector<PixelSampleList> pixels(3, stratified(sqrtPlus, 2, 4));
   StoredSampleLayout layout = layoutOf(pixels, 2, 8);
   std::vector<float> samples = store(pixels, layout);
-  cl::Buffer buffer(testDevice().context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, samples.size() * sizeof(float),
-                    samples.data());
+  cl::Buffer buffer = deviceBuffer(samples);
   const std::vector<double> costs{1.0, 1.0};
   StoredSampleLayout overfull = layout, tooLarge = layout, wrongM = layout;
   overfull.taken = layout.capacity + 1;
   tooLarge.pixelCount = 17;  // a second block the buffer does not hold
   wrongM.techniqueCount = 3;
-  for (const StoredSampleLayout& bad : {overfull, tooLarge}) {
-    CHECK_THROWS_AS(deviceSearch(2).run(buffer, bad, costs), std::invalid_argument);
-    CHECK_THROWS_AS(gridSearchReference(samples, bad, costs), std::invalid_argument);
+  GridSearchReference reference(2, 3);
+  for (const StoredSampleLayout& bad : {overfull, tooLarge, wrongM}) {
+    CHECK_THROWS_AS(deviceSearch(2, 3).run(buffer, bad, costs), std::invalid_argument);
+    CHECK_THROWS_AS(reference.run(samples, bad, costs), std::invalid_argument);
   }
-  CHECK_THROWS_AS(deviceSearch(2).run(buffer, wrongM, costs), std::invalid_argument);
-  CHECK(deviceSearch(2).run(buffer, layout, costs).fallbackCount() == 0);
+  CHECK(deviceSearch(2, 3).run(buffer, layout, costs).fallbackCount() == 0);
+  CHECK(reference.run(samples, layout, costs).fallbackCount() == 0);
+  CHECK_THROWS_AS(GridSearchReference(1, 3), std::invalid_argument);
+  CHECK_THROWS_AS(GridSearchReference(2, 3, 0), std::invalid_argument);
 }

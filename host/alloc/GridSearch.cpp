@@ -39,10 +39,13 @@ void checkTechniqueCount(int techniqueCount) {
         fmt::format("grid search: {} techniques; it needs 2 to {}", techniqueCount, kMaxTechniques));
 }
 
-void checkLayout(const StoredSampleLayout& layout, int techniqueCount, std::size_t availableFloats) {
+void checkLayout(const StoredSampleLayout& layout, int techniqueCount, int pixelCount, std::size_t availableFloats) {
   if (layout.techniqueCount != techniqueCount)
     throw std::invalid_argument(fmt::format("grid search: samples of {} techniques, search built for {}",
                                             layout.techniqueCount, techniqueCount));
+  if (layout.pixelCount != pixelCount)
+    throw std::invalid_argument(
+        fmt::format("grid search: samples of {} pixels, search built for {}", layout.pixelCount, pixelCount));
   if (layout.pixelCount < 0 || layout.taken < 0 || layout.taken > layout.capacity)
     throw std::invalid_argument(fmt::format("grid search: {} pixels, {} of {} samples taken", layout.pixelCount,
                                             layout.taken, layout.capacity));
@@ -78,6 +81,16 @@ int closestResolution(int techniqueCount, int approximateSize) {
   return above - approximateSize <= approximateSize - below ? r + 1 : r;
 }
 
+// The grid size rounded up to whole passes.
+int paddedGridSize(int gridSize) { return (gridSize + kPass - 1) / kPass * kPass; }
+
+// Floats of running sums per pixel: Σ g and Σ g² for every technique and combination
+// of the grid makeWeightGrid makes (and validates), padded to whole passes.
+std::size_t runningSumFloats(int techniqueCount, int gridSize) {
+  int size = makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0)).size();
+  return std::size_t(2) * techniqueCount * paddedGridSize(size);
+}
+
 // The grid as the passes read it: α_{k,l} at [k · paddedSize + l] and the cost per
 // sample at [l], the size rounded up to whole passes with copies of the last
 // combination, which are summed but never selected.
@@ -88,7 +101,7 @@ struct LaneGrid {
 
 LaneGrid laneGrid(const WeightGrid& grid) {
   const int m = grid.techniqueCount, u = grid.size();
-  LaneGrid lanes{(u + kPass - 1) / kPass * kPass, {}, {}};
+  LaneGrid lanes{paddedGridSize(u), {}, {}};
   lanes.alpha.resize(std::size_t(m) * lanes.paddedSize);
   lanes.cost.resize(lanes.paddedSize);
   for (int l = 0; l < lanes.paddedSize; ++l) {
@@ -115,21 +128,25 @@ struct SearchSetup {
   int rule;
 };
 
-// Σ g and Σ g² over each technique's samples for every combination l, at
-// [j · paddedSize + l] (000 Alg. 1 line 8): the kernel's sumTechnique as plain loops,
-// with the same operations in the same order.
+// Adds g and g² of each technique's new samples to its sums for every combination l
+// (000 Alg. 1 line 8), the sums at `sums` (runningSumIndex) first brought to the current
+// scale: the kernel's loadSums, sumTechnique and storeSums as plain loops, with the
+// same operations in the same order.
 template <int M>
-void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
-              float* sumG2) {
+void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
+              float* sums) {
   const int padded = setup.lanes.paddedSize;
   const float* alpha = setup.lanes.alpha.data();
+  const float rescale2 = rescale * rescale;
   for (int j = 0; j < M; ++j) {
-    float* s = sumG + j * padded;
-    float* s2 = sumG2 + j * padded;
-    std::fill(s, s + padded, 0.0f);
-    std::fill(s2, s2 + padded, 0.0f);
-    const float* x = prepared + kern::preparedFirst(summary, j) * (M + 1);
-    for (int i = 0; i < summary.nonZero[j]; ++i, x += M + 1) {
+    float* s = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
+    float* s2 = sums + kern::runningSumIndex(0, j, 1, 0, M, padded);
+    for (int l = 0; l < padded; ++l) {
+      s[l] = rescale == 0.0f ? 0.0f : s[l] * rescale;
+      s2[l] = rescale == 0.0f ? 0.0f : s2[l] * rescale2;
+    }
+    const float* x = prepared + kern::preparedFirst(added, j) * (M + 1);
+    for (int i = 0; i < added.nonZero[j]; ++i, x += M + 1) {
       for (int l0 = 0; l0 < padded; l0 += kPass) {
 #pragma omp simd
         for (int lane = 0; lane < 16; ++lane) {
@@ -151,54 +168,63 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const
   }
 }
 
-void sumPixel(const SearchSetup& setup, const kern::PixelSummary& summary, const float* prepared, float* sumG,
-              float* sumG2) {
+void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
+              float* sums) {
   switch (setup.layout.techniqueCount) {
     case 2:
-      return sumPixel<2>(setup, summary, prepared, sumG, sumG2);
+      return sumPixel<2>(setup, added, prepared, rescale, sums);
     case 3:
-      return sumPixel<3>(setup, summary, prepared, sumG, sumG2);
+      return sumPixel<3>(setup, added, prepared, rescale, sums);
     default:
-      return sumPixel<4>(setup, summary, prepared, sumG, sumG2);
+      return sumPixel<4>(setup, added, prepared, rescale, sums);
   }
 }
 
-// Per-thread buffers of the reference.
-struct Scratch {
-  std::vector<float> prepared, sumG, sumG2;
-};
-
-// 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it.
-void searchPixel(const SearchSetup& setup, int pixel, Scratch& scratch, Allocation& allocation, int& selected) {
+// The best l₀ by the pixel's sums (000 Alg. 1 line 13), −1 if none could be ranked.
+int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, const float* sums) {
   const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
-  const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
-  kern::PixelSummary summary = kern::emptySummary();
-  for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&summary, pixelSamples, m, i);
-  unsigned fallbacks = kern::pixelFallbacks(m, summary);
+  float invCount[kMaxTechniques], bestScore = -INFINITY;
+  for (int j = 0; j < m; ++j) invCount[j] = 1.0f / all.count[j];
   int best = -1;
-  if (fallbacks == 0) {
-    int next[kMaxTechniques];
-    for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(summary, j);
-    for (int i = 0; i < setup.layout.taken; ++i)
-      kern::prepareSample(pixelSamples, m, i, kern::sampleScale(summary), next, scratch.prepared.data());
-    sumPixel(setup, summary, scratch.prepared.data(), scratch.sumG.data(), scratch.sumG2.data());
-    float invCount[kMaxTechniques], bestScore = -INFINITY;
-    for (int j = 0; j < m; ++j) invCount[j] = 1.0f / summary.count[j];
-    for (int l = 0; l < setup.grid.size(); ++l) {
-      float g1[kMaxTechniques], g2[kMaxTechniques];
-      for (int j = 0; j < m; ++j) {
-        g1[j] = scratch.sumG[j * padded + l];
-        g2[j] = scratch.sumG2[j * padded + l];
-      }
-      float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(), g1,
-                                    g2, invCount);
-      if (score > bestScore) {
-        bestScore = score;
-        best = l;
-      }
+  for (int l = 0; l < setup.grid.size(); ++l) {
+    float g1[kMaxTechniques], g2[kMaxTechniques];
+    for (int j = 0; j < m; ++j) {
+      g1[j] = sums[kern::runningSumIndex(0, j, 0, l, m, padded)];
+      g2[j] = sums[kern::runningSumIndex(0, j, 1, l, m, padded)];
     }
-    if (best < 0) fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
+    float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(), g1,
+                                  g2, invCount);
+    if (score > bestScore) {
+      bestScore = score;
+      best = l;
+    }
   }
+  return best;
+}
+
+// 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it: adds the
+// new samples to `summary` and the running sums at `sums`, then selects.
+void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepared, kern::PixelSummary& summary,
+                 float* sums, Allocation& allocation, int& selected) {
+  const int m = setup.layout.techniqueCount;
+  const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
+  kern::PixelSummary added = kern::emptySummary();
+  for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&added, pixelSamples, m, i);
+  const kern::PixelSummary all = kern::mergeSummaries(summary, added);
+  unsigned fallbacks = kern::pixelFallbacks(m, all);
+  int best = -1;
+  // Pixels that cannot be ranked yet keep their sums for the searches to come.
+  if (kern::hasSums(all)) {
+    const float scale = kern::sampleScale(all);
+    int next[kMaxTechniques];
+    for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(added, j);
+    for (int i = 0; i < setup.layout.taken; ++i) kern::prepareSample(pixelSamples, m, i, scale, next, prepared.data());
+    sumPixel(setup, added, prepared.data(), kern::sumsRescale(summary, scale), sums);
+    if (fallbacks == 0) best = bestCombination(setup, all, sums);
+  }
+  if (fallbacks == 0 && best < 0)
+    fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
+  summary = all;
   selected = fallbacks == 0 ? best : -1;
   allocation = fallbacks != 0
                    ? equalFallback(m, fallbacks)
@@ -228,23 +254,47 @@ std::size_t StoredSampleLayout::floatCount() const {
   return (std::size_t(pixelCount) + 15) / 16 * 16 * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
 
+std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize) {
+  return runningSumFloats(techniqueCount, gridSize) * sizeof(float) + sizeof(kern::PixelSummary);
+}
+
 int GridSearchResult::fallbackCount() const {
   return static_cast<int>(
       std::count_if(allocations.begin(), allocations.end(), [](const Allocation& a) { return a.usedFallback(); }));
 }
 
-GridSearch::GridSearch(const Device& device, int techniqueCount) : device_(device), techniqueCount_(techniqueCount) {
-  checkTechniqueCount(techniqueCount);
+GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize)
+    : device_(device), techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
+  const std::size_t sumFloats = runningSumFloats(techniqueCount, gridSize);
   cl::Program program =
       buildProgram(device, "gridsearch.cl",
                    fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors));
   kernel_ = cl::Kernel(program, "gridSearch");
+  // OpenCL buffers cannot be empty.
+  const std::size_t pixels = std::max(1, pixelCount);
+  summaries_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(kern::PixelSummary));
+  // Only pixels with hasSums read their sums, so reset() leaves them; they are written
+  // once here so that the first search does not pay a page fault per 4 KiB of them.
+  const std::size_t sumBytes = pixels * sumFloats * sizeof(float);
+  sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
+  device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
+  reset();
+  // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
+  // with a search of no samples, not inside the first timed one.
+  cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
+  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, std::vector<double>(techniqueCount, 1.0));
+}
+
+void GridSearch::reset() {
+  // An all-zero PixelSummary is emptySummary().
+  device_.queue.enqueueFillBuffer(summaries_, cl_uchar(0), 0, summaries_.getInfo<CL_MEM_SIZE>());
+  device_.queue.finish();
 }
 
 GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLayout& layout,
-                                 const std::vector<double>& costs, int gridSize, GridRule rule) {
-  checkLayout(layout, techniqueCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
-  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize, costs);
+                                 const std::vector<double>& costs, GridRule rule) {
+  checkLayout(layout, techniqueCount_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
+  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   const int m = techniqueCount_, pixels = layout.pixelCount;
   GridSearchResult result;
   if (pixels == 0) return result;
@@ -276,6 +326,8 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   kernel_.setArg(a++, cost);
   kernel_.setArg(a++, cl_int(kernelRule(rule)));
   kernel_.setArg(a++, prepared_);
+  kernel_.setArg(a++, summaries_);
+  kernel_.setArg(a++, sums_);
   kernel_.setArg(a++, alphaOut);
   kernel_.setArg(a++, selectedOut);
   kernel_.setArg(a++, fallbacksOut);
@@ -304,13 +356,29 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   return result;
 }
 
-GridSearchResult gridSearchReference(const std::vector<float>& samples, const StoredSampleLayout& layout,
-                                     const std::vector<double>& costs, int gridSize, GridRule rule) {
-  checkTechniqueCount(layout.techniqueCount);
-  checkLayout(layout, layout.techniqueCount, samples.size());
-  WeightGrid grid = makeWeightGrid(layout.techniqueCount, gridSize, costs);
+// What the reference keeps from run to run, as the kernel keeps it on the device.
+struct GridSearchReference::RunningSums {
+  std::vector<kern::PixelSummary> summaries;
+  std::vector<float> sums;  // runningSumIndex
+};
+
+GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize)
+    : techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
+  running_ = std::make_unique<RunningSums>();
+  running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(techniqueCount, gridSize));
+  reset();
+}
+
+GridSearchReference::~GridSearchReference() = default;
+
+void GridSearchReference::reset() { running_->summaries.assign(std::max(0, pixelCount_), kern::emptySummary()); }
+
+GridSearchResult GridSearchReference::run(const std::vector<float>& samples, const StoredSampleLayout& layout,
+                                          const std::vector<double>& costs, GridRule rule) {
+  checkLayout(layout, techniqueCount_, pixelCount_, samples.size());
+  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
-  const std::size_t sums = std::size_t(layout.techniqueCount) * setup.lanes.paddedSize;
+  const std::size_t pixelSums = std::size_t(2) * techniqueCount_ * setup.lanes.paddedSize;
 
   GridSearchResult result;
   result.allocations.resize(layout.pixelCount);
@@ -318,11 +386,11 @@ GridSearchResult gridSearchReference(const std::vector<float>& samples, const St
   auto start = std::chrono::steady_clock::now();
 #pragma omp parallel
   {
-    Scratch scratch{std::vector<float>(std::size_t(layout.taken) * (layout.techniqueCount + 1)),
-                    std::vector<float>(sums), std::vector<float>(sums)};
+    std::vector<float> prepared(std::size_t(layout.taken) * (layout.techniqueCount + 1));
 #pragma omp for schedule(dynamic, 16)
     for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
-      searchPixel(setup, pixel, scratch, result.allocations[pixel], result.selected[pixel]);
+      searchPixel(setup, pixel, prepared, running_->summaries[pixel], running_->sums.data() + pixel * pixelSums,
+                  result.allocations[pixel], result.selected[pixel]);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

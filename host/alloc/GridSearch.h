@@ -1,11 +1,12 @@
 #pragma once
 // Havran & Sbert's "exact" allocation (000 Sec. 4.2, Algorithm 1): for every pixel,
 // the weight combination out of a grid of U that is best according to the pixel's
-// stored samples, by one of two rules. GridSearch runs kernels/gridsearch.cl on a
-// device; gridSearchReference is its C++ reference and OpenMP peer.
+// samples so far, by one of two rules. GridSearch runs kernels/gridsearch.cl on a
+// device; GridSearchReference is its C++ reference and OpenMP peer.
 
 #include <CL/opencl.hpp>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "alloc/Allocation.h"
@@ -43,7 +44,8 @@ WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::ve
 
 // Where the stored samples are: the blocked float layout of kernels/stats.h
 // (storedSampleIndex), `capacity` slots per pixel of which the first `taken` are filled
-// for every pixel, pixels padded to a multiple of 16.
+// for every pixel, pixels padded to a multiple of 16. A search reads the `taken`
+// samples as those taken since the previous search.
 struct StoredSampleLayout {
   int pixelCount = 0;
   int techniqueCount = 0;
@@ -53,6 +55,10 @@ struct StoredSampleLayout {
   std::size_t floatCount() const;
 };
 
+// What a search keeps per pixel from run to run: Σ g and Σ g² for every technique and
+// combination (the grid padded to whole passes) and the summary of the samples.
+std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize);
+
 struct GridSearchResult {
   std::vector<Allocation> allocations;  // per pixel; equal weights where it fell back
   std::vector<int> selected;            // l₀ per pixel, −1 where it fell back
@@ -61,30 +67,48 @@ struct GridSearchResult {
   int fallbackCount() const;
 };
 
-// Runs kernels/gridsearch.cl; the program is built once for M techniques. A scratch
-// buffer of taken · (M + 1) floats per pixel, for the samples as the sums read them,
-// is kept from run to run.
+// Runs kernels/gridsearch.cl for `pixelCount` pixels over makeWeightGrid(techniqueCount,
+// gridSize, ·); the program is built and its first launch compiled once. Each run adds
+// the samples stored since the previous one to every pixel's running sums
+// (gridSearchBytesPerPixel, on the device) and selects by all the samples added so far.
+// A scratch buffer of taken · (M + 1) floats per pixel, for the new samples as the sums
+// read them, is kept from run to run.
 class GridSearch {
  public:
-  GridSearch(const Device& device, int techniqueCount);
+  // Throws std::invalid_argument for M outside 2..kMaxTechniques or a grid size < 1.
+  GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize);
 
-  // Throws std::invalid_argument for a layout that does not match M or the buffer,
-  // taken > capacity, or what makeWeightGrid rejects.
+  // Throws std::invalid_argument for a layout that does not match M, the pixel count
+  // or the buffer, taken > capacity, or costs that makeWeightGrid rejects.
   GridSearchResult run(const cl::Buffer& samples, const StoredSampleLayout& layout, const std::vector<double>& costs,
-                       int gridSize = kDefaultGridSize, GridRule rule = GridRule::MinCostVariance);
+                       GridRule rule = GridRule::MinCostVariance);
+  // Forgets the samples added so far.
+  void reset();
 
  private:
   const Device& device_;
-  int techniqueCount_;
+  int techniqueCount_, pixelCount_, gridSize_;
   cl::Kernel kernel_;
-  cl::Buffer prepared_;
+  cl::Buffer summaries_, sums_, prepared_;
   std::size_t preparedFloats_ = 0;
 };
 
 // The same search with plain loops, one pixel per OpenMP iteration and the weight
-// combinations innermost, on the same stored samples (host memory).
-GridSearchResult gridSearchReference(const std::vector<float>& samples, const StoredSampleLayout& layout,
-                                     const std::vector<double>& costs, int gridSize = kDefaultGridSize,
-                                     GridRule rule = GridRule::MinCostVariance);
+// combinations innermost, on the same stored samples (host memory), keeping the same
+// running sums in host memory.
+class GridSearchReference {
+ public:
+  GridSearchReference(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize);
+  ~GridSearchReference();
+
+  GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
+                       const std::vector<double>& costs, GridRule rule = GridRule::MinCostVariance);
+  void reset();
+
+ private:
+  struct RunningSums;  // kernels/gridsearch.h's types, which this header does not include
+  int techniqueCount_, pixelCount_, gridSize_;
+  std::unique_ptr<RunningSums> running_;
+};
 
 }  // namespace misalloc

@@ -25,12 +25,13 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
 HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
   if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
+  if (config.gridSize > 0)
+    gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize);
 }
 
 StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
-  if (config_.sampleCapacity > 0 && plan.samplesBefore + plan.stageSamples > config_.sampleCapacity)
-    throw std::logic_error("stage overflows the stored-samples buffer");
+  const int firstSlot = takeSlots(plan);
   kern::EnvmapView env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
   kern::TechniqueSet ts;
   ts.techniqueCount = M;
@@ -71,7 +72,7 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
         if (s.technique == slot / perTechnique)
           running[slot] += kern::statValue(int(config_.statsMask), slot % perTechnique, s);
       if (config_.sampleCapacity > 0) {
-        int i = plan.samplesBefore + j;
+        int i = firstSlot + j;
         samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, M)] = float(s.technique);
         samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, M)] = s.y;
         for (int l = 0; l < M; ++l)

@@ -137,8 +137,7 @@ void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> c
 // Every pixel's weights from all its samples so far.
 std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
                                             int taken) {
-  if (method == Method::Exact)
-    return sampler.searchWeights(options.costs, options.gridSize, options.gridRule, taken).allocations;
+  if (method == Method::Exact) return sampler.searchWeights(options.costs, options.gridRule).allocations;
   const int pixels = sampler.scene().pixelCount(), M = sampler.scene().techniqueCount(), slots = sampler.statSlots();
   std::vector<double> stats = sampler.statistics();
   std::vector<float> stored = methodStoresSamples(method) ? sampler.storedSamples() : std::vector<float>{};
@@ -159,11 +158,12 @@ std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocatio
                                  bool cumulative = true) {
   const int M = int(progress.taken.size() / progress.fellBack.size());
   std::vector<int32_t> out(progress.taken.size());
+#pragma omp parallel for schedule(static, 1024)
   for (size_t p = 0; p < allocations.size(); ++p) {
     std::vector<int> taken(progress.taken.begin() + p * M, progress.taken.begin() + (p + 1) * M);
-    std::vector<int> counts =
-        cumulative ? nextStageCounts(taken, allocations[p].alpha, progress.samplesBefore + stageSamples)
-                   : apportionCounts(allocations[p].alpha, stageSamples);
+    std::vector<int> counts = cumulative
+                                  ? nextStageCounts(taken, allocations[p].alpha, progress.samplesBefore + stageSamples)
+                                  : apportionCounts(allocations[p].alpha, stageSamples);
     progress.fellBack[p] |= allocations[p].usedFallback() ? 1 : 0;
     progress.floored[p] |= floorCounts(counts) ? 1 : 0;
     std::copy(counts.begin(), counts.end(), out.begin() + p * M);
@@ -180,6 +180,14 @@ std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
   return out;
 }
 
+// The largest stage of the schedule whatever the technique count M, which the sampler
+// config does not know: the pilot takes max(2M, f·N) ≤ max(2·kMaxTechniques, f·N)
+// samples, and the stages after it are largest after the smallest pilot, that of M = 2.
+int largestStage(const AdaptiveOptions& options, int spp) {
+  std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, 2);
+  return std::max(*std::max_element(sizes.begin(), sizes.end()), std::min(spp, 2 * kMaxTechniques));
+}
+
 }  // namespace
 
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options) {
@@ -187,7 +195,11 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   config.estimator = isAdaptive(method) ? methodEstimator(method) : fixedSplitEstimator;
   config.statsMask = methodStatistics(method);
   config.sampleCapacity = methodStoresSamples(method) ? spp : 0;
-  if (method == Method::Oracle) config.sampleCapacity = options.oracleSamples + spp;
+  // The grid searches keep running sums: the samples of one stage at a time (the
+  // oracle's probe, then its render stage) are stored.
+  if (method == Method::Exact) config.sampleCapacity = largestStage(options, spp);
+  if (method == Method::Oracle) config.sampleCapacity = std::max(options.oracleSamples, spp);
+  if (method == Method::Exact || method == Method::Oracle) config.gridSize = options.gridSize;
   return config;
 }
 
@@ -211,9 +223,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     auto probeStart = Clock::now();
     takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples,
               options.oracleSamples, ~seed);
-    std::vector<Allocation> best =
-        sampler.searchWeights(options.costs, options.gridSize, GridRule::MinCostVariance, options.oracleSamples)
-            .allocations;
+    std::vector<Allocation> best = sampler.searchWeights(options.costs, GridRule::MinCostVariance).allocations;
     out.allocationSeconds = secondsSince(probeStart);
     Progress render{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
                     std::vector<int>(size_t(pixels) * M, 0),
@@ -242,8 +252,9 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   out.variance = std::move(progress.totals.variance);
   out.alpha.resize(progress.taken.size());
   for (size_t i = 0; i < progress.taken.size(); ++i) out.alpha[i] = double(progress.taken[i]) / spp;
-  out.statisticsBytesPerPixel =
-      double(sampler.statSlots()) * sizeof(double) + double(sampler.storedSampleCount()) * sizeof(float) / pixels;
+  out.statisticsBytesPerPixel = double(sampler.statSlots()) * sizeof(double) +
+                                double(sampler.storedSampleCount()) * sizeof(float) / pixels +
+                                double(sampler.searchBytesPerPixel());
   out.kernelSeconds = progress.totals.kernelSeconds;
   out.wallSeconds = secondsSince(start);
   out.hostSeconds = std::max(0.0, out.wallSeconds - out.kernelSeconds - out.allocationSeconds);

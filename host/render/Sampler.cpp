@@ -25,7 +25,8 @@ std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t c
 
 StageSampler::StageSampler(const Scene& scene, const SamplerConfig& config) : scene_(scene), config_(config) {
   if (config.sampleCapacity < 0) throw std::invalid_argument("negative sample capacity");
-  if (config.estimator == Estimator::OneSample && (config.statsMask != 0 || config.sampleCapacity > 0))
+  if (config.estimator == Estimator::OneSample &&
+      (config.statsMask != 0 || config.sampleCapacity > 0 || config.gridSize > 0))
     throw std::invalid_argument("the allocations' statistics are kept for the multi-sample estimators only");
 }
 
@@ -38,8 +39,27 @@ size_t StageSampler::storedSampleCount() const {
   return paddedPixels * size_t(config_.sampleCapacity) * size_t(scene_.techniqueCount() + 2);
 }
 
-StoredSampleLayout StageSampler::storedSampleLayout(int taken) const {
-  return {scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken};
+size_t StageSampler::searchBytesPerPixel() const {
+  return config_.gridSize > 0 ? gridSearchBytesPerPixel(scene_.techniqueCount(), config_.gridSize) : 0;
+}
+
+int StageSampler::takeSlots(const StagePlan& plan) {
+  const int slot = plan.samplesBefore - searched_;
+  if (slot < 0) throw std::logic_error("stage overwrites samples the grid search already added");
+  if (config_.sampleCapacity > 0 && slot + plan.stageSamples > config_.sampleCapacity)
+    throw std::logic_error("stage overflows the stored-samples buffer");
+  taken_ = plan.samplesBefore + plan.stageSamples;
+  return slot;
+}
+
+GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, GridRule rule) {
+  if (config_.gridSize <= 0 || config_.sampleCapacity <= 0)
+    throw std::logic_error("grid search on a sampler that does not keep what it needs");
+  GridSearchResult result = search(
+      StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken_ - searched_},
+      costs, rule);
+  searched_ = taken_;
+  return result;
 }
 
 std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
@@ -87,6 +107,8 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   samples_ = config.sampleCapacity > 0
                  ? upload(device, emptyStoredSamples(scene, config.sampleCapacity), CL_MEM_READ_WRITE)
                  : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  if (config.gridSize > 0)
+    gridSearch_ = std::make_unique<GridSearch>(device, scene.techniqueCount(), scene.pixelCount(), config.gridSize);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
   StagePlan empty;
@@ -100,8 +122,7 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
   if (plan.techniqueCount != M || plan.counts.size() != size_t(pixels) * M)
     throw std::logic_error("stage plan does not match the scene");
-  if (config_.sampleCapacity > 0 && plan.samplesBefore + plan.stageSamples > config_.sampleCapacity)
-    throw std::logic_error("stage overflows the stored-samples buffer");
+  const int firstSlot = takeSlots(plan);
   const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
   cl::Buffer counts = upload(device_, plan.counts), firstIndex = upload(device_, plan.firstIndex);
   cl::Buffer rgb(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * 3 * accSize);
@@ -124,7 +145,7 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   kernel_.setArg(a++, moments);
   kernel_.setArg(a++, stats_);
   kernel_.setArg(a++, samples_);
-  kernel_.setArg(a++, cl_int(plan.samplesBefore));
+  kernel_.setArg(a++, cl_int(firstSlot));
   kernel_.setArg(a++, cl_int(config_.sampleCapacity));
   size_t global = (size_t(pixels) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
@@ -149,13 +170,8 @@ std::vector<double> Sampler::statistics() {
   return doubleSums_ ? readSums<double>(device_, stats_, n) : readSums<float>(device_, stats_, n);
 }
 
-GridSearchResult Sampler::searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) {
-  if (!gridSearch_) {
-    gridSearch_ = std::make_unique<GridSearch>(device_, scene_.techniqueCount());
-    // As for the sampling kernel: the first launch's compilation is not search time.
-    gridSearch_->run(samples_, storedSampleLayout(0), costs, gridSize, rule);
-  }
-  return gridSearch_->run(samples_, storedSampleLayout(taken), costs, gridSize, rule);
+GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) {
+  return gridSearch_->run(samples_, layout, costs, rule);
 }
 
 std::vector<float> Sampler::storedSamples() {

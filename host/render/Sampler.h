@@ -24,20 +24,31 @@ class StageSampler {
   // samples in the layout of kernels/stats.h's storedSampleIndex.
   virtual std::vector<double> statistics() = 0;
   virtual std::vector<float> storedSamples() = 0;
-  // 000 Algorithm 1 over the first `taken` stored samples of every pixel
-  // (kernels/gridsearch.cl on a device, its C++ reference on the host).
-  virtual GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule,
-                                         int taken) = 0;
+  // 000 Algorithm 1 over every sample taken so far, with the grid of config().gridSize:
+  // the searches keep running sums, and each adds the samples of the stages since the
+  // one before (kernels/gridsearch.cl on a device, its C++ reference on the host).
+  GridSearchResult searchWeights(const std::vector<double>& costs, GridRule rule);
 
   const Scene& scene() const { return scene_; }
   const SamplerConfig& config() const { return config_; }
-  int statSlots() const;             // running sums per pixel
-  size_t storedSampleCount() const;  // floats in the stored-samples buffer
-  StoredSampleLayout storedSampleLayout(int taken) const;
+  int statSlots() const;               // running sums per pixel
+  size_t storedSampleCount() const;    // floats in the stored-samples buffer
+  size_t searchBytesPerPixel() const;  // the grid searches' running sums
 
  protected:
+  // Records the stage and returns the stored-samples slot of its first sample. Slot i
+  // holds sample searched_ + i: the samples before are in the grid searches' sums.
+  // Throws std::logic_error if the stage does not fit.
+  int takeSlots(const StagePlan& plan);
+  virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs,
+                                  GridRule rule) = 0;
+
   const Scene& scene_;
   SamplerConfig config_;
+
+ private:
+  int searched_ = 0;  // samples per pixel that the grid searches have added
+  int taken_ = 0;     // samples per pixel taken so far
 };
 
 // The `-D` options that compile kernels/sample.cl for exactly this scene, estimator,
@@ -52,11 +63,12 @@ class Sampler : public StageSampler {
   StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
-  GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) override;
 
  private:
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override;
+
   const Device& device_;
-  std::unique_ptr<GridSearch> gridSearch_;  // built at the first search
+  std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
   int localSize_;
   bool doubleSums_;
   cl::Kernel kernel_;
@@ -71,13 +83,15 @@ class HostSampler : public StageSampler {
   StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override { return stats_; }
   std::vector<float> storedSamples() override { return samples_; }
-  GridSearchResult searchWeights(const std::vector<double>& costs, int gridSize, GridRule rule, int taken) override {
-    return gridSearchReference(samples_, storedSampleLayout(taken), costs, gridSize, rule);
-  }
 
  private:
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override {
+    return gridSearch_->run(samples_, layout, costs, rule);
+  }
+
   std::vector<double> stats_;
   std::vector<float> samples_;
+  std::unique_ptr<GridSearchReference> gridSearch_;  // where config().gridSize > 0
 };
 
 // Padding lanes of the stored samples: technique 0, f = 0 and every pdf 1, so that

@@ -34,7 +34,10 @@ struct StageResult {
 struct SamplerConfig {
   Estimator estimator = Estimator::MultiSample;
   unsigned statsMask = 0;  // running sums kept across stages (kernels/stats.h)
-  int sampleCapacity = 0;  // > 0: every sample is stored, up to this many per pixel
+  // > 0: every sample taken since the last grid search (all of them, without searches)
+  // is stored, up to this many per pixel.
+  int sampleCapacity = 0;
+  int gridSize = 0;  // > 0: grid searches (000 Algorithm 1) over about this many combinations
 };
 
 }  // namespace misalloc
