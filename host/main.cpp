@@ -300,6 +300,7 @@ int main(int argc, char** argv) {
       std::cout << fmt::format("wrote {} and {}{}\n", out, reportPath,
                                alphaMap.empty() ? "" : fmt::format(", {} and {}", alphaMap, alphaPngPath(alphaMap)));
     } else if (app.got_subcommand("compare")) {
+      InterruptionGuard guard;  // first: every thread started from here on inherits its mask
       if (suite) {
         for (const char* sceneOption : {"--envmap", "--grid", "--envmap-sampler", "--split-brdf"})
           if (compareCmd->count(sceneOption) > 0)
@@ -319,7 +320,7 @@ int main(int argc, char** argv) {
       compare.budgets = parseBudgets(budgetList);
       compare.adaptive = compareAdaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
       validateCompareOptions(compare);
-      Comparison comparison = runComparison(compare);
+      Comparison comparison = runComparison(compare, guard);
       Summary summary = summarize(comparison, compare);
       writeCompareReport(summary, compare.outDir);
       if (comparison.interrupted) {

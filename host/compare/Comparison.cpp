@@ -7,7 +7,6 @@
 
 #include "AtomicFile.h"
 #include "Error.h"
-#include "compare/Interruption.h"
 #include "compare/ProgressMeter.h"
 #include "render/AlphaMap.h"
 #include "render/Costs.h"
@@ -137,8 +136,7 @@ void validateCompareOptions(const CompareOptions& options) {
   }
 }
 
-Comparison runComparison(const CompareOptions& options) {
-  InterruptionGuard guard;
+Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard) {
   fs::create_directories(options.outDir);
   const int perCase = int(options.methods.size() * options.budgets.size()) * options.repeats;
   ProgressMeter meter(int(options.cases.size()) * perCase);
@@ -162,7 +160,7 @@ Comparison runComparison(const CompareOptions& options) {
     for (Method method : options.methods)
       for (int budget : options.budgets)
         for (int r = 0; r < options.repeats; ++r) {
-          if (InterruptionGuard::requested()) {
+          if (guard.requested()) {
             out.interrupted = true;
             writeRuns(options.outDir, out);
             return out;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "compare/Interruption.h"
 #include "render/Method.h"
 #include "render/Render.h"
 #include "render/Scene.h"
@@ -69,8 +70,8 @@ struct Comparison {
 // Every case × method × budget × repeat, in that order. Writes each repeat-0 render's
 // image and α map (EXR + PNG) under outDir/<case>/ as it goes, and the runs so far to
 // outDir/runs.{json,csv} after each one, all atomically. Stops after the render in
-// flight when SIGINT or SIGTERM arrives (Comparison::interrupted).
-Comparison runComparison(const CompareOptions& options);
+// flight when `guard` reports SIGINT or SIGTERM (Comparison::interrupted).
+Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard);
 
 // Throws InputError for a budget that some adaptive method cannot split into a pilot
 // and its stages, and for an empty or unknown list.

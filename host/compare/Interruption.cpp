@@ -1,30 +1,30 @@
 #include "compare/Interruption.h"
 
-#include <csignal>
+#include <pthread.h>
+
+#include <ctime>
 
 namespace misalloc {
-namespace {
-
-volatile std::sig_atomic_t gRequested = 0;
-
-extern "C" void onInterrupt(int signal) {
-  gRequested = 1;
-  std::signal(signal, SIG_DFL);
-}
-
-}  // namespace
 
 InterruptionGuard::InterruptionGuard() {
-  gRequested = 0;
-  std::signal(SIGINT, onInterrupt);
-  std::signal(SIGTERM, onInterrupt);
+  sigemptyset(&signals_);
+  sigaddset(&signals_, SIGINT);
+  sigaddset(&signals_, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals_, &previousMask_);
 }
 
 InterruptionGuard::~InterruptionGuard() {
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  // Consume what is pending, so that unblocking delivers nothing.
+  const timespec now{0, 0};
+  while (sigtimedwait(&signals_, nullptr, &now) > 0) {
+  }
+  pthread_sigmask(SIG_SETMASK, &previousMask_, nullptr);
 }
 
-bool InterruptionGuard::requested() { return gRequested != 0; }
+bool InterruptionGuard::requested() {
+  const timespec now{0, 0};
+  if (!requested_ && sigtimedwait(&signals_, nullptr, &now) > 0) requested_ = true;
+  return requested_;
+}
 
 }  // namespace misalloc
