@@ -47,8 +47,8 @@ MA_FN float envmapPdfOfTexel(EnvmapView env, float texelProbability, float sinTh
   return texelProbability * (float)env.width * (float)env.height / (2.0f * MA_PI * MA_PI * ma_max(sinTheta, 1e-7f));
 }
 
-MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) {
-  int t = texelOfDirection(env, w);
+// Radiance and pdf at ω inside texel t.
+MA_FN EnvmapHit envmapTexelHit(EnvmapView env, int t, MaVec3 w) {
   EnvmapHit hit;
   if (env.coskExponent >= 0.0f) {
     hit.r = hit.g = hit.b = w.z > 0.0f ? fastPow(w.z, env.coskExponent) : 0.0f;
@@ -60,6 +60,8 @@ MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) {
   hit.pdf = envmapPdfOfTexel(env, env.texels[4 * t + 3], ma_sqrt(w.x * w.x + w.y * w.y));
   return hit;
 }
+
+MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) { return envmapTexelHit(env, texelOfDirection(env, w), w); }
 
 // Vose alias table. The bucket comes from a full 32-bit integer and the coin from an
 // independent uniform: one 24-bit uniform for both is biased for large tables.
@@ -90,14 +92,26 @@ MA_FN int sampleCdfTable(EnvmapView env, float uRow, float uCol) {
   return row * env.width + col;
 }
 
-MA_FN MaVec3 sampleEnvmap(EnvmapView env, MaRandom4 rnd) {
+typedef struct {
+  MaVec3 w;
+  int texel;  // the texel drawn, which holds w
+} EnvmapSample;
+
+// The pdf of a drawn direction is that of the texel it was drawn in (as pbrt-v4's
+// ImageInfiniteLight::SampleLi): envmapTexelHit then needs no texelOfDirection, whose
+// inverse trigonometry and dependent gather would follow the alias table's gather.
+// Both agree except where rounding puts w on a neighbouring texel's edge.
+MA_FN EnvmapSample sampleEnvmap(EnvmapView env, MaRandom4 rnd) {
   int t = env.useCdf ? sampleCdfTable(env, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
                      : sampleAliasTable(env, rnd.v[0], uniformFloat(rnd.v[1]));
   int row = t / env.width;
   int col = t - row * env.width;
   float u = ((float)col + uniformFloat(rnd.v[2])) / (float)env.width;
   float v = ((float)row + uniformFloat(rnd.v[3])) / (float)env.height;
-  return latLongDirection(u, v);
+  EnvmapSample s;
+  s.w = latLongDirection(u, v);
+  s.texel = t;
+  return s;
 }
 
 #endif

@@ -19,11 +19,26 @@ typedef struct {
   MaVec3 mirror;       // mirror direction of ω_o about the normal (z)
 } TechniqueSet;
 
-MA_FN MaVec3 sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd) {
-  if (technique == MA_TECHNIQUE_ENVMAP) return sampleEnvmap(env, rnd);
-  if (!ts.splitBrdf) return sampleBrdf(b, ts.mirror, rnd);
-  float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
-  return technique == 1 ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
+typedef struct {
+  MaVec3 wi;
+  int texel;  // technique 0: the envmap texel it drew wi in
+} TechniqueSample;
+
+MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique,
+                                      MaRandom4 rnd) {
+  TechniqueSample s;
+  s.texel = 0;
+  if (technique == MA_TECHNIQUE_ENVMAP) {
+    EnvmapSample e = sampleEnvmap(env, rnd);
+    s.wi = e.w;
+    s.texel = e.texel;
+  } else if (!ts.splitBrdf) {
+    s.wi = sampleBrdf(b, ts.mirror, rnd);
+  } else {
+    float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
+    s.wi = technique == 1 ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
+  }
+  return s;
 }
 
 // p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i.
@@ -46,8 +61,13 @@ typedef struct {
   float pdfs[MA_MAX_TECHNIQUES];
 } SampleValue;
 
-MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi) {
-  EnvmapHit hit = envmapLookup(env, wi);
+// f and every p_k at the direction that `technique` drew. A constant `technique` folds
+// the envmap lookup to one of its two cases.
+MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, int technique,
+                                 TechniqueSample sample) {
+  MaVec3 wi = sample.wi;
+  int texel = technique == MA_TECHNIQUE_ENVMAP ? sample.texel : texelOfDirection(env, wi);
+  EnvmapHit hit = envmapTexelHit(env, texel, wi);
   float cosTheta = ma_max(wi.z, 0.0f);
   float lobe = phongLobe(b, wi, ts.mirror);
   float brdfCos = phongBrdf(b, lobe) * cosTheta;

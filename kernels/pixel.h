@@ -28,30 +28,23 @@ typedef struct {
   ma_acc ww0, ww1, ww2;  // per technique: Σ w²
 } PixelSums;
 
-// Sample j of the stage. Multi-sample: the first n0 samples are technique 0's, the next
-// n1 technique 1's, ... One-sample: the technique is drawn with probabilities α_k.
-MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c, int j,
-                                         ma_uint seedLo, ma_uint seedHi, ma_uint pixel) {
+// α_k = n_k / N: each technique's share of the stage (one-sample: its probability).
+MA_FN void stageFractions(StageCounts c, float* alpha) {
   float N = (float)c.stageSamples;
-  float alpha[MA_MAX_TECHNIQUES];
   alpha[0] = (float)c.n0 / N;
   alpha[1] = (float)c.n1 / N;
   alpha[2] = (float)c.n2 / N;
-  int technique;
-  ma_uint index;
-  if (c.oneSample) {
-    MaRandom4 choice = philoxDraw(seedLo, seedHi, pixel, MA_STREAM_TECHNIQUE_CHOICE, c.first0 + (ma_uint)j);
-    technique = chooseTechnique(c.techniqueCount, alpha, uniformFloat(choice.v[0]));
-    index = c.first0 + (ma_uint)j;
-  } else {
-    technique = j < c.n0 ? 0 : (j < c.n0 + c.n1 ? 1 : 2);
-    int start = technique == 0 ? 0 : (technique == 1 ? c.n0 : c.n0 + c.n1);
-    ma_uint first = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
-    index = first + (ma_uint)(j - start);
-  }
+}
+
+// The sample of `technique` with that technique's sample index `index`.
+MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c,
+                                             int technique, ma_uint index, ma_uint seedLo, ma_uint seedHi,
+                                             ma_uint pixel) {
+  float N = (float)c.stageSamples;
+  float alpha[MA_MAX_TECHNIQUES];
+  stageFractions(c, alpha);
   MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
-  MaVec3 wi = sampleTechnique(ts, env, b, technique, rnd);
-  SampleValue s = evaluateSample(ts, env, b, wi);
+  SampleValue s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
   // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k (000 eq. 4.2). Count-independent
   // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) (002 eq. 26).
   float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
@@ -72,6 +65,27 @@ MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongP
   MA_UNROLL
   for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) out.pdfs[k] = s.pdfs[k];
   return out;
+}
+
+// Sample j of the stage. Multi-sample: the first n0 samples are technique 0's, the next
+// n1 technique 1's, ... One-sample: the technique is drawn with probabilities α_k.
+MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c, int j,
+                                         ma_uint seedLo, ma_uint seedHi, ma_uint pixel) {
+  int technique;
+  ma_uint index;
+  if (c.oneSample) {
+    float alpha[MA_MAX_TECHNIQUES];
+    stageFractions(c, alpha);
+    MaRandom4 choice = philoxDraw(seedLo, seedHi, pixel, MA_STREAM_TECHNIQUE_CHOICE, c.first0 + (ma_uint)j);
+    technique = chooseTechnique(c.techniqueCount, alpha, uniformFloat(choice.v[0]));
+    index = c.first0 + (ma_uint)j;
+  } else {
+    technique = j < c.n0 ? 0 : (j < c.n0 + c.n1 ? 1 : 2);
+    int start = technique == 0 ? 0 : (technique == 1 ? c.n0 : c.n0 + c.n1);
+    ma_uint first = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
+    index = first + (ma_uint)(j - start);
+  }
+  return takeTechniqueSample(ts, env, b, c, technique, index, seedLo, seedHi, pixel);
 }
 
 MA_FN PixelSums zeroPixelSums(void) {

@@ -17,12 +17,12 @@
 enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
 
 // Everything one sample needs, re-read from global memory (cached) at each sample for
-// the same reason.
+// the same reason. Sample j of `technique`'s samples (one-sample: of the stage).
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, int width, int height,
                                        __global const float* brdfParams, MaVec3 mirror, __global const int* counts,
                                        __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-                                       int pixel, int j) {
+                                       int pixel, int technique, int j) {
   EnvmapView env;
   env.texels = texels;
   env.cdfTable = cdfTable;
@@ -57,7 +57,12 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   c.first0 = first[0];
   c.first1 = first[1];
   c.first2 = MA_TECHNIQUES > 2 ? first[MA_TECHNIQUES - 1] : 0u;
+#if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
+#else
+  uint firstOfTechnique = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
+  return takeTechniqueSample(ts, env, b, c, technique, firstOfTechnique + (uint)j, seedLo, seedHi, (uint)pixel);
+#endif
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
@@ -74,36 +79,54 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
-  for (int j = 0; j < stageSamples; ++j) {
-    SampleContribution c =
-        sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams, makeVec3(mirrorX, mirrorY, mirrorZ),
-                      counts, firstIndex, stageSamples, seedLo, seedHi, pixel, j);
-    ma_acc w = (ma_acc)c.w, ww = w * w;
-    sums[SUM_R][lid] += (ma_acc)c.r;
-    sums[SUM_G][lid] += (ma_acc)c.g;
-    sums[SUM_B][lid] += (ma_acc)c.b;
-    sums[SUM_W0][lid] += c.technique == 0 ? w : 0;
-    sums[SUM_WW0][lid] += c.technique == 0 ? ww : 0;
-    sums[SUM_W1][lid] += c.technique == 1 ? w : 0;
-    sums[SUM_WW1][lid] += c.technique == 1 ? ww : 0;
-    if (MA_TECHNIQUES > 2) {
-      sums[SUM_W2][lid] += c.technique == 2 ? w : 0;
-      sums[SUM_WW2][lid] += c.technique == 2 ? ww : 0;
-    }
+  // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
+  // that the technique is a constant in the loop and the vectorised code runs its
+  // sampler only. A work-group runs its largest n_k; the other work-items' surplus
+  // samples are not counted. One-sample: one pass of N samples.
+  __local int passCounts[MA_LOCAL_SIZE];
+  int start = 0;  // the pass's first sample in the stage
+  MA_UNROLL
+  for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
+    int n = MA_ONE_SAMPLE ? stageSamples : counts[pixel * MA_TECHNIQUES + k];
+    passCounts[lid] = n;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    int passSamples = 0;
     MA_UNROLL
-    for (int s = 0; s < STAT_SLOTS; ++s) {
-      int perTechnique = MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES);
-      running[s][lid] += c.technique == s / perTechnique ? statValue(MA_STATS, s % perTechnique, c) : 0;
-    }
-    if (MA_STORE_SAMPLES && gid < pixelCount) {
-      int i = firstSlot + j;
-      samples[storedSampleIndex(pixel, i, 0, sampleCapacity, MA_TECHNIQUES)] = (float)c.technique;
-      samples[storedSampleIndex(pixel, i, 1, sampleCapacity, MA_TECHNIQUES)] = c.y;
+    for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
+    barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
+    for (int jk = 0; jk < passSamples; ++jk) {
+      SampleContribution c =
+          sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams, makeVec3(mirrorX, mirrorY, mirrorZ),
+                        counts, firstIndex, stageSamples, seedLo, seedHi, pixel, k, jk);
+      int counted = jk < n, j = start + jk;
+      ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
+      sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;
+      sums[SUM_G][lid] += counted ? (ma_acc)c.g : 0;
+      sums[SUM_B][lid] += counted ? (ma_acc)c.b : 0;
+      sums[SUM_W0][lid] += c.technique == 0 ? w : 0;
+      sums[SUM_WW0][lid] += c.technique == 0 ? ww : 0;
+      sums[SUM_W1][lid] += c.technique == 1 ? w : 0;
+      sums[SUM_WW1][lid] += c.technique == 1 ? ww : 0;
+      if (MA_TECHNIQUES > 2) {
+        sums[SUM_W2][lid] += c.technique == 2 ? w : 0;
+        sums[SUM_WW2][lid] += c.technique == 2 ? ww : 0;
+      }
       MA_UNROLL
-      for (int l = 0; l < MA_TECHNIQUES; ++l)
-        samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, MA_TECHNIQUES)] = c.pdfs[l];
+      for (int s = 0; s < STAT_SLOTS; ++s) {
+        int perTechnique = MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES);
+        running[s][lid] += counted && c.technique == s / perTechnique ? statValue(MA_STATS, s % perTechnique, c) : 0;
+      }
+      if (MA_STORE_SAMPLES && counted && gid < pixelCount) {
+        int i = firstSlot + j;
+        samples[storedSampleIndex(pixel, i, 0, sampleCapacity, MA_TECHNIQUES)] = (float)c.technique;
+        samples[storedSampleIndex(pixel, i, 1, sampleCapacity, MA_TECHNIQUES)] = c.y;
+        MA_UNROLL
+        for (int l = 0; l < MA_TECHNIQUES; ++l)
+          samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, MA_TECHNIQUES)] = c.pdfs[l];
+      }
+      barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
     }
-    barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
+    start += n;
   }
   if (gid < pixelCount) {
     estimate[3 * pixel + 0] = sums[SUM_R][lid];

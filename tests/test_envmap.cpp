@@ -433,7 +433,9 @@ TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]
       for (uint32_t i = 0; i < 100000; ++i) {
         kern::MaRandom4 r = kern::philoxDraw(0xd1ec, 7, 1, 0, i);
         int t = sampledTexel(view, r);
-        kern::MaVec3 w = kern::sampleEnvmap(view, r);
+        kern::EnvmapSample sample = kern::sampleEnvmap(view, r);
+        REQUIRE(sample.texel == t);
+        kern::MaVec3 w = sample.w;
         double theta = std::atan2(std::hypot(double(w.x), double(w.y)), double(w.z));
         double phi = std::atan2(double(w.y), double(w.x));
         int row = t / tables.width, col = t % tables.width;
