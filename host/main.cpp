@@ -132,7 +132,7 @@ AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
 // "all" or a comma-separated list of method names, each once.
 std::vector<Method> parseMethodList(const std::string& list) {
   if (list == "all")
-    return {Method::Envmap, Method::Brdf,   Method::Equal, Method::Heuristic,
+    return {Method::Envmap,     Method::Brdf,   Method::Equal, Method::Heuristic,
             Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
   std::vector<Method> methods;
   std::stringstream items(list);
@@ -264,8 +264,8 @@ int main(int argc, char** argv) {
       if (isAdaptive(m) && m != Method::Oracle)
         stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
       if (m == Method::Oracle && adaptive.oracleSamples < 2 * scene.techniqueCount())
-        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
-                                     adaptive.oracleSamples));
+        throw InputError(
+            fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
       std::unique_ptr<Device> device;
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
       auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);

@@ -69,13 +69,14 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable, int width,
     int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
     __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-    int pixelCount, __global ma_acc* estimate, __global ma_acc* moments, __global ma_acc* stats,
-    __global float* samples, int firstSlot, int sampleCapacity) {
+    int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate, __global ma_acc* moments,
+    __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
-  // Padding work-items run the loop too: the barrier needs every work-item.
-  int pixel = gid < pixelCount ? gid : pixelCount - 1;
+  // Pixels in the host's order (coherentPixelOrder): work-groups of like counts. Padding
+  // work-items run the loop too: the barrier needs every work-item.
+  int pixel = pixelOrder[gid < pixelCount ? gid : pixelCount - 1];
   for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];

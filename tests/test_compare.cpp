@@ -118,8 +118,7 @@ TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out"
   std::string md = summaryMarkdown(s);
   CHECK(md.find("| exact | – |") != std::string::npos);
   CHECK(md.find("## RMSE×1000 at 10 spp") != std::string::npos);
-  CHECK(summaryCsv(s) == fmt::format("method,a\nequal,10.0000\nheuristic,{:.4f}\nexact,\n",
-                                     h->budgets[0].rmseX1000));
+  CHECK(summaryCsv(s) == fmt::format("method,a\nequal,10.0000\nheuristic,{:.4f}\nexact,\n", h->budgets[0].rmseX1000));
   std::string svg = errorTimePlotSvg(a);
   CHECK(svg.rfind("<svg", 0) == 0);
   CHECK(svg.find("</svg>") != std::string::npos);
@@ -132,9 +131,10 @@ TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out"
 TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][compare]") {
   TempDir dir("compare");
   const fs::path out = dir.path / "out";
-  auto r = runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 "
-                                   "--methods equal,heuristic,exact,brdf --device cpu --out-dir {} --cache-dir {}",
-                                   out.string(), (dir.path / "cache").string()));
+  auto r =
+      runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 "
+                              "--methods equal,heuristic,exact,brdf --device cpu --out-dir {} --cache-dir {}",
+                              out.string(), (dir.path / "cache").string()));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   for (const char* file : {"index.html", "summary.md", "summary.csv", "summary.json", "budgets.csv", "runs.json",
@@ -180,8 +180,8 @@ TEST_CASE("compare rejects bad options before it writes anything", "[cli][compar
       {"--cost 1", "expected 2 numbers"},
   };
   for (const Case& c : cases) {
-    auto r = runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10 --out-dir {} {}",
-                                     out.string(), c.args));
+    auto r = runMisalloc(
+        fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10 --out-dir {} {}", out.string(), c.args));
     INFO(c.args << "\n" << r.output);
     CHECK(r.exitCode == 2);
     CHECK(r.output.find(c.expected) != std::string::npos);

@@ -70,8 +70,12 @@ nlohmann::json runJson(const RunRecord& r) {
 }
 
 nlohmann::json caseJson(const CaseInfo& c) {
-  return {{"label", c.label},         {"scene", c.scene},   {"techniques", c.techniques},
-          {"costs_s_per_sample", c.costs}, {"costs_source", c.costSource}, {"reference", c.referenceSource},
+  return {{"label", c.label},
+          {"scene", c.scene},
+          {"techniques", c.techniques},
+          {"costs_s_per_sample", c.costs},
+          {"costs_source", c.costSource},
+          {"reference", c.referenceSource},
           {"device", c.device}};
 }
 
@@ -89,8 +93,8 @@ std::string runsCsv(const Comparison& comparison) {
 
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
 void writeRuns(const std::string& outDir, const Comparison& comparison) {
-  nlohmann::json json = {{"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()},
-                         {"runs", nlohmann::json::array()}};
+  nlohmann::json json = {
+      {"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
   for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseJson(c));
   for (const RunRecord& r : comparison.runs) json["runs"].push_back(runJson(r));
   writeFileAtomically(outDir + "/runs.json", json.dump(2) + "\n");
@@ -114,14 +118,15 @@ void validateCompareOptions(const CompareOptions& options) {
   if (options.methods.empty()) throw InputError("--methods: no method");
   if (options.budgets.empty()) throw InputError("--budgets: no budget");
   for (size_t i = 0; i < options.budgets.size(); ++i) {
-    if (options.budgets[i] < 1) throw InputError(fmt::format("--budgets: {} is not a positive spp", options.budgets[i]));
+    if (options.budgets[i] < 1)
+      throw InputError(fmt::format("--budgets: {} is not a positive spp", options.budgets[i]));
     if (i > 0 && options.budgets[i] <= options.budgets[i - 1])
       throw InputError("--budgets: list each budget once, in ascending order");
   }
   if (options.repeats < 1) throw InputError(fmt::format("--repeats {}: need at least 1", options.repeats));
   if (options.adaptive.gridSize < 2)
-    throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations",
-                                 options.adaptive.gridSize));
+    throw InputError(
+        fmt::format("--grid-u {}: the search needs at least 2 weight combinations", options.adaptive.gridSize));
   for (const CompareCase& c : options.cases) {
     const int M = c.scene.splitBrdf ? 3 : 2;
     if (!options.adaptive.costs.empty() && int(options.adaptive.costs.size()) != M)
@@ -131,7 +136,8 @@ void validateCompareOptions(const CompareOptions& options) {
         throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
                                      options.adaptive.oracleSamples));
       if (isAdaptive(m) && m != Method::Oracle)
-        for (int budget : options.budgets) stageSizes(options.adaptive.pilotFraction, options.adaptive.stages, budget, M);
+        for (int budget : options.budgets)
+          stageSizes(options.adaptive.pilotFraction, options.adaptive.stages, budget, M);
     }
   }
 }
@@ -146,8 +152,8 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     Scene scene = makeScene(c.scene);
     fs::create_directories(fs::path(options.outDir) / c.label);
     auto plain = makeStageSampler(options.device, device, scene, SamplerConfig{}, options.localSize);
-    meter.note(fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label,
-                           options.referenceSpp));
+    meter.note(
+        fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
     std::optional<Reference> reference = findReference(*plain, scene, options.referenceSpp, options.cacheDir, true);
     AdaptiveOptions adaptive = options.adaptive;
     bool measured = adaptive.costs.empty();
@@ -165,9 +171,9 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
             writeRuns(options.outDir, out);
             return out;
           }
-          auto sampler = makeStageSampler(options.device, device, scene,
-                                          samplerConfigFor(method, Estimator::MultiSample, budget, adaptive),
-                                          options.localSize);
+          auto sampler =
+              makeStageSampler(options.device, device, scene,
+                               samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize);
           const uint64_t seed = options.seed + uint64_t(r);
           Rendering rendering = render(*sampler, method, adaptive, budget, seed);
           out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference->image));

@@ -15,21 +15,29 @@ constexpr double kLeft = 70, kRight = 170, kTop = 40, kBottom = 55;  // margins;
 // A colour per method that stays the same across plots.
 const char* methodColour(Method m) {
   switch (m) {
-    case Method::Envmap: return "#1f77b4";
-    case Method::Brdf: return "#d62728";
-    case Method::Equal: return "#000000";
-    case Method::Heuristic: return "#2ca02c";
-    case Method::SigmaSqrtC: return "#9467bd";
-    case Method::Linear: return "#8c564b";
-    case Method::Exact: return "#ff7f0e";
-    case Method::Oracle: return "#7f7f7f";
+    case Method::Envmap:
+      return "#1f77b4";
+    case Method::Brdf:
+      return "#d62728";
+    case Method::Equal:
+      return "#000000";
+    case Method::Heuristic:
+      return "#2ca02c";
+    case Method::SigmaSqrtC:
+      return "#9467bd";
+    case Method::Linear:
+      return "#8c564b";
+    case Method::Exact:
+      return "#ff7f0e";
+    case Method::Oracle:
+      return "#7f7f7f";
   }
   return "#000000";
 }
 
 // A logarithmic axis over whole decades around [lo, hi].
 struct LogAxis {
-  double lo, hi;  // decades' exponents
+  double lo, hi;    // decades' exponents
   double from, to;  // pixels
 
   LogAxis(double minValue, double maxValue, double from, double to)
@@ -105,8 +113,9 @@ std::string errorTimePlotSvg(const CaseSummary& scene) {
       double lo = std::max(b.rmseX1000 - b.rmseSpreadX1000, 0.5 * b.rmseX1000);
       svg += fmt::format(R"(<line x1="{0:.1f}" y1="{1:.1f}" x2="{0:.1f}" y2="{2:.1f}" stroke="{3}"/>)", px, y(lo),
                          y(b.rmseX1000 + b.rmseSpreadX1000), colour);
-      svg += fmt::format(R"(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"><title>{} {} spp: {:.2f} at {:.3g} s</title></circle>)",
-                         px, py, colour, methodName(m.method), b.budget, b.rmseX1000, b.wallSeconds);
+      svg += fmt::format(
+          R"(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"><title>{} {} spp: {:.2f} at {:.3g} s</title></circle>)",
+          px, py, colour, methodName(m.method), b.budget, b.rmseX1000, b.wallSeconds);
     }
     svg += fmt::format(R"(<polyline points="{}" fill="none" stroke="{}" stroke-width="1.5"/>)", points, colour) + "\n";
     double ly = kTop + 10 + 20 * row++;

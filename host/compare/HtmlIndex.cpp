@@ -32,8 +32,9 @@ std::string imageGrid(const Summary& s, const CaseSummary& c) {
     for (int b : s.budgets) {
       const BudgetStats* stats = m.at(b);
       std::string path = previewPath(imagePath(c.info.label, m.method, b));
-      out += stats ? "<td>" + image(path, fmt::format("{} {} spp: RMSE×1000 {:.2f}", methodName(m.method), b,
-                                                      stats->rmseX1000)) +
+      out += stats ? "<td>" +
+                         image(path,
+                               fmt::format("{} {} spp: RMSE×1000 {:.2f}", methodName(m.method), b, stats->rmseX1000)) +
                          fmt::format("<br>{:.2f}</td>", stats->rmseX1000)
                    : "<td>–</td>";
     }
@@ -50,15 +51,17 @@ std::string imageGrid(const Summary& s, const CaseSummary& c) {
 std::string plotFileName(const std::string& caseLabel) { return "plot_" + caseLabel + ".svg"; }
 
 std::string indexHtml(const Summary& s) {
-  std::string out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-                    "<title>misalloc compare</title>\n" +
-                    std::string(kStyle) + "</head>\n<body>\n<h1>misalloc compare</h1>\n";
+  std::string out =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<title>misalloc compare</title>\n" +
+      std::string(kStyle) + "</head>\n<body>\n<h1>misalloc compare</h1>\n";
   if (s.interrupted) out += "<p><b>Interrupted: only the budgets that every repeat finished are shown.</b></p>\n";
   if (!s.cases.empty())
-    out += fmt::format("<p class=\"note\">Device: {}. Budgets (spp): {}. Times are wall-clock seconds per render "
-                       "(sampling kernels, allocation and host work). Errors are against each scene's reference; "
-                       "the spread is the standard deviation over repeats with independent seeds.</p>\n",
-                       s.cases.front().info.device, fmt::join(s.budgets, ", "));
+    out += fmt::format(
+        "<p class=\"note\">Device: {}. Budgets (spp): {}. Times are wall-clock seconds per render "
+        "(sampling kernels, allocation and host work). Errors are against each scene's reference; "
+        "the spread is the standard deviation over repeats with independent seeds.</p>\n",
+        s.cases.front().info.device, fmt::join(s.budgets, ", "));
   out += fmt::format("<h2>RMSE×1000 at {} spp (000 Table 5.2 layout)</h2>\n", s.tableBudget) + html(rmseTable(s));
   out += "<h2>Speed-up over equal at equal error (median over budgets)</h2>\n" + html(speedUpTable(s));
   out += fmt::format("<h2>Seconds per render at {} spp: wall (kernel + allocation)</h2>\n", s.tableBudget) +
@@ -68,9 +71,10 @@ std::string indexHtml(const Summary& s) {
     out += fmt::format("<p class=\"note\">Costs per sample (s): {:.3g}. Reference: {}.</p>\n",
                        fmt::join(c.info.costs, ", "), c.info.referenceSource);
     out += fmt::format("<img src=\"{}\" alt=\"error against time\">\n", plotFileName(c.info.label));
-    out += "<h3>Equal-time RMSE×1000</h3>\n<p class=\"note\">At equal's mean render times; ~: continued past the "
-           "measured times with MSE ∝ 1/t.</p>\n" +
-           html(equalTimeTable(c));
+    out +=
+        "<h3>Equal-time RMSE×1000</h3>\n<p class=\"note\">At equal's mean render times; ~: continued past the "
+        "measured times with MSE ∝ 1/t.</p>\n" +
+        html(equalTimeTable(c));
     out += "<h3>Images (repeat 0)</h3>\n<p>Reference: " + image(c.info.label + "/reference.png", "reference") +
            "</p>\n" + imageGrid(s, c);
   }

@@ -11,14 +11,14 @@ namespace misalloc {
 struct BudgetStats {
   int budget = 0;
   int repeats = 0;
-  double mse = 0;               // mean over repeats
-  double rmseX1000 = 0;         // 1000 √(mean MSE)
-  double rmseSpreadX1000 = 0;   // sample standard deviation of the repeats' RMSE × 1000
-  double relativeMse = 0;       // mean
+  double mse = 0;              // mean over repeats
+  double rmseX1000 = 0;        // 1000 √(mean MSE)
+  double rmseSpreadX1000 = 0;  // sample standard deviation of the repeats' RMSE × 1000
+  double relativeMse = 0;      // mean
   double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;  // means
-  double efficiency = 0;        // 1/(mean MSE × mean time)
+  double efficiency = 0;                                                              // 1/(mean MSE × mean time)
   std::vector<double> meanAlpha;
-  CurveValue speedUp;           // over equal at this error (speedUpOver); 0 without equal
+  CurveValue speedUp;  // over equal at this error (speedUpOver); 0 without equal
 };
 
 struct MethodSummary {

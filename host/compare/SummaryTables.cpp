@@ -36,10 +36,17 @@ std::string escapeHtml(const std::string& text) {
   std::string out;
   for (char ch : text) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      default: out += ch;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      default:
+        out += ch;
     }
   }
   return out;
@@ -131,7 +138,8 @@ std::string html(const TextTable& table) {
   out += "</tr>\n";
   for (const auto& row : table.rows) {
     out += "<tr>";
-    for (const TableCell& c : row) out += c.best ? "<td><b>" + escapeHtml(c.text) + "</b></td>" : "<td>" + escapeHtml(c.text) + "</td>";
+    for (const TableCell& c : row)
+      out += c.best ? "<td><b>" + escapeHtml(c.text) + "</b></td>" : "<td>" + escapeHtml(c.text) + "</td>";
     out += "</tr>\n";
   }
   return out + "</table>\n";
@@ -162,9 +170,10 @@ std::string summaryMarkdown(const Summary& s) {
       "reaches, in wall-clock time per render (sampling, allocation and host); the median over the budgets. Above 1: "
       "the method pays off.\n\n";
   out += markdown(speedUpTable(s));
-  out += fmt::format("\n## Time per render at {} spp\n\nWall seconds (sampling kernels + allocation); the rest is host "
-                     "work.\n\n",
-                     s.tableBudget);
+  out += fmt::format(
+      "\n## Time per render at {} spp\n\nWall seconds (sampling kernels + allocation); the rest is host "
+      "work.\n\n",
+      s.tableBudget);
   out += markdown(timeTable(s));
   out +=
       "\n## Equal-time error per scene\n\nRMSE×1000 of each method interpolated (log–log) at equal's mean render "
@@ -211,12 +220,12 @@ nlohmann::json summaryJson(const Summary& s) {
       nlohmann::json budgets = nlohmann::json::array(), equalTime = nlohmann::json::array();
       for (const BudgetStats& b : m.budgets) budgets.push_back(budgetJson(b));
       for (const CurveValue& v : m.equalTimeRmseX1000) equalTime.push_back(curveValueJson(v));
-      methods.push_back({{"method", methodName(m.method)},
-                         {"budgets", budgets},
-                         {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
-                         {"median_speed_up_over_equal",
-                          m.medianSpeedUp ? nlohmann::json(*m.medianSpeedUp) : nlohmann::json()},
-                         {"equal_time_rmse_x1000", equalTime}});
+      methods.push_back(
+          {{"method", methodName(m.method)},
+           {"budgets", budgets},
+           {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
+           {"median_speed_up_over_equal", m.medianSpeedUp ? nlohmann::json(*m.medianSpeedUp) : nlohmann::json()},
+           {"equal_time_rmse_x1000", equalTime}});
     }
     cases.push_back({{"label", c.info.label},
                      {"scene", c.info.scene},
@@ -229,8 +238,11 @@ nlohmann::json summaryJson(const Summary& s) {
   }
   nlohmann::json methods = nlohmann::json::array();
   for (Method m : s.methods) methods.push_back(methodName(m));
-  return {{"interrupted", s.interrupted}, {"table_spp", s.tableBudget}, {"budgets", s.budgets},
-          {"methods", methods},           {"cases", cases}};
+  return {{"interrupted", s.interrupted},
+          {"table_spp", s.tableBudget},
+          {"budgets", s.budgets},
+          {"methods", methods},
+          {"cases", cases}};
 }
 
 }  // namespace misalloc

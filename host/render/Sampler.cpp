@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <numeric>
+
 #include "Error.h"
 #include "KernelCode.h"
 
@@ -118,6 +120,29 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   run(empty, 0);
 }
 
+namespace {
+
+// The order in which work-items take pixels. A work-group runs each technique's loop
+// for its largest count (kernels/sample.cl, sampleStage), so pixels with like counts
+// share work-groups: sorted by (n_0, …, n_{M−2}) with a stable counting sort, ties
+// by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
+// work-group, so the order changes the time only, never the result.
+std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, int pixels) {
+  std::vector<int32_t> order(pixels), sorted(pixels);
+  std::iota(order.begin(), order.end(), 0);
+  const int M = plan.techniqueCount;
+  for (int k = M - 2; k >= 0; --k) {  // least significant key first
+    std::vector<int> start(size_t(plan.stageSamples) + 2, 0);
+    for (int p : order) ++start[plan.counts[size_t(p) * M + k] + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    for (int p : order) sorted[start[plan.counts[size_t(p) * M + k]]++] = p;
+    order.swap(sorted);
+  }
+  return order;
+}
+
+}  // namespace
+
 StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
   if (plan.techniqueCount != M || plan.counts.size() != size_t(pixels) * M)
@@ -125,6 +150,7 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   const int firstSlot = takeSlots(plan);
   const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
   cl::Buffer counts = upload(device_, plan.counts), firstIndex = upload(device_, plan.firstIndex);
+  cl::Buffer pixelOrder = upload(device_, coherentPixelOrder(plan, pixels));
   cl::Buffer rgb(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * 3 * accSize);
   cl::Buffer moments(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * M * 2 * accSize);
   int a = 0;
@@ -141,6 +167,7 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   kernel_.setArg(a++, cl_uint(seed & 0xffffffffu));
   kernel_.setArg(a++, cl_uint(seed >> 32));
   kernel_.setArg(a++, cl_int(pixels));
+  kernel_.setArg(a++, pixelOrder);
   kernel_.setArg(a++, rgb);
   kernel_.setArg(a++, moments);
   kernel_.setArg(a++, stats_);
