@@ -33,6 +33,15 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference", "[sampler]") {
       for (const SamplerConfig& config : configs) {
         Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s);
         StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
+        // Counts that differ from pixel to pixel, each technique at least one: work-groups
+        // then mix counts (kernels/sample.cl runs each technique's loop for the largest).
+        const int M = plan.techniqueCount;
+        for (int p = 0; p < scene.pixelCount(); ++p) {
+          int32_t* n = plan.counts.data() + size_t(p) * M;
+          n[0] = 1 + (p * 7) % 45;
+          n[M - 1] = 50 - n[0] - (M - 2) * (1 + p % 3);
+          if (M == 3) n[1] = 1 + p % 3;
+        }
         Sampler device(testDevice(), scene, config);
         HostSampler host(scene, config);
         size_t mismatches = 0;
