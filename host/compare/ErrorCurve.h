@@ -4,7 +4,7 @@
 
 namespace misalloc {
 
-// One method's mean error at each of its budgets, against its mean wall time.
+// One method's mean error at each of its budgets, against its median wall time.
 struct CurvePoint {
   double seconds = 0;
   double mse = 0;

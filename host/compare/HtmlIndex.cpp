@@ -72,7 +72,7 @@ std::string indexHtml(const Summary& s) {
                        fmt::join(c.info.costs, ", "), c.info.referenceSource);
     out += fmt::format("<img src=\"{}\" alt=\"error against time\">\n", plotFileName(c.info.label));
     out +=
-        "<h3>Equal-time RMSE×1000</h3>\n<p class=\"note\">At equal's mean render times; ~: continued past the "
+        "<h3>Equal-time RMSE×1000</h3>\n<p class=\"note\">At equal's median render times; ~: continued past the "
         "measured times with MSE ∝ 1/t.</p>\n" +
         html(equalTimeTable(c));
     out += "<h3>Images (repeat 0)</h3>\n<p>Reference: " + image(c.info.label + "/reference.png", "reference") +

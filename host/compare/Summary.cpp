@@ -7,28 +7,41 @@
 namespace misalloc {
 namespace {
 
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// Errors are averaged; times take the median, which a render slowed by another
+// process on a shared machine does not move.
 BudgetStats reduceRepeats(const std::vector<const RunRecord*>& runs) {
   BudgetStats s;
   s.budget = runs.front()->budget;
   s.repeats = int(runs.size());
   s.meanAlpha.assign(runs.front()->meanAlpha.size(), 0.0);
+  std::vector<double> wall, kernel, allocation, host;
   double sumRmse = 0, sumRmse2 = 0;
   for (const RunRecord* r : runs) {
     s.mse += r->mse;
     s.relativeMse += r->relativeMse;
-    s.wallSeconds += r->wallSeconds;
-    s.kernelSeconds += r->kernelSeconds;
-    s.allocationSeconds += r->allocationSeconds;
-    s.hostSeconds += r->hostSeconds;
+    wall.push_back(r->wallSeconds);
+    kernel.push_back(r->kernelSeconds);
+    allocation.push_back(r->allocationSeconds);
+    host.push_back(r->hostSeconds);
     for (size_t k = 0; k < s.meanAlpha.size(); ++k) s.meanAlpha[k] += r->meanAlpha[k];
     double rmse = 1000 * std::sqrt(r->mse);
     sumRmse += rmse;
     sumRmse2 += rmse * rmse;
   }
   const double n = s.repeats;
-  for (double* v : {&s.mse, &s.relativeMse, &s.wallSeconds, &s.kernelSeconds, &s.allocationSeconds, &s.hostSeconds})
-    *v /= n;
+  s.mse /= n;
+  s.relativeMse /= n;
   for (double& a : s.meanAlpha) a /= n;
+  s.wallSeconds = median(wall);
+  s.kernelSeconds = median(kernel);
+  s.allocationSeconds = median(allocation);
+  s.hostSeconds = median(host);
   s.rmseX1000 = 1000 * std::sqrt(s.mse);
   s.rmseSpreadX1000 = n > 1 ? std::sqrt(std::max(0.0, (sumRmse2 - sumRmse * sumRmse / n) / (n - 1))) : 0;
   s.efficiency = 1 / (s.mse * s.wallSeconds);
@@ -45,12 +58,6 @@ MethodSummary summarizeMethod(const Comparison& comparison, const std::string& c
     if (int(runs.size()) == repeats) m.budgets.push_back(reduceRepeats(runs));
   }
   return m;
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 bool usableCurve(const MethodSummary& m) {

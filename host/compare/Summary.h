@@ -15,8 +15,8 @@ struct BudgetStats {
   double rmseX1000 = 0;        // 1000 √(mean MSE)
   double rmseSpreadX1000 = 0;  // sample standard deviation of the repeats' RMSE × 1000
   double relativeMse = 0;      // mean
-  double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;  // means
-  double efficiency = 0;                                                              // 1/(mean MSE × mean time)
+  double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;  // medians
+  double efficiency = 0;                                                              // 1/(mean MSE × median time)
   std::vector<double> meanAlpha;
   CurveValue speedUp;  // over equal at this error (speedUpOver); 0 without equal
 };
@@ -35,7 +35,7 @@ struct MethodSummary {
 struct CaseSummary {
   CaseInfo info;
   std::vector<MethodSummary> methods;
-  // The common time budgets of the equal-time comparison: equal's mean times at its
+  // The common time budgets of the equal-time comparison: equal's median times at its
   // budgets (the first method's when equal was not run).
   std::vector<double> commonSeconds;
 

@@ -157,8 +157,9 @@ std::string summaryMarkdown(const Summary& s) {
     int repeats = 0;
     for (const MethodSummary& m : first->methods)
       if (!m.budgets.empty()) repeats = m.budgets.front().repeats;
-    out += fmt::format("Device: {}. Budgets (spp): {}. Repeats with independent seeds: {}.\n\n", first->info.device,
-                       fmt::join(s.budgets, ", "), repeats);
+    out += fmt::format(
+        "Device: {}. Budgets (spp): {}. Repeats with independent seeds: {}. Times are medians over the repeats.\n\n",
+        first->info.device, fmt::join(s.budgets, ", "), repeats);
   }
   out += fmt::format(
       "## RMSE×1000 at {} spp\n\nThe layout of 000 Table 5.2: the RMSE of RGB over the image against the reference, "
@@ -176,7 +177,7 @@ std::string summaryMarkdown(const Summary& s) {
       s.tableBudget);
   out += markdown(timeTable(s));
   out +=
-      "\n## Equal-time error per scene\n\nRMSE×1000 of each method interpolated (log–log) at equal's mean render "
+      "\n## Equal-time error per scene\n\nRMSE×1000 of each method interpolated (log–log) at equal's median render "
       "times; `~` marks values continued past the method's measured times with the Monte Carlo law MSE ∝ 1/t.\n";
   for (const CaseSummary& c : s.cases) out += "\n### " + c.info.label + "\n\n" + markdown(equalTimeTable(c));
   return out;
