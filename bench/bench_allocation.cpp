@@ -54,8 +54,7 @@ AdaptiveOptions benchOptions() {
   return options;
 }
 
-// One render per iteration on one sampler. The running sums carry over from render to
-// render; the allocation rules do the same arithmetic whatever their values.
+// One render per iteration on one sampler (each render starts it afresh).
 void renderAndTime(benchmark::State& state, StageSampler& sampler, Method method) {
   const AdaptiveOptions options = benchOptions();
   render(sampler, method, options, config.spp, 1);  // warm-up: the grid search's first launch

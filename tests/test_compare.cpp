@@ -112,7 +112,8 @@ TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out"
   CHECK(h->budgets[0].rmseSpreadX1000 == Approx(std::sqrt(200.0)));  // sample sd of 90 and 110
   CHECK(h->budgets[1].rmseSpreadX1000 == Approx(0).margin(1e-9));
   CHECK(a.find(Method::Exact)->budgets.empty());
-  CHECK(a.find(Method::Equal)->medianSpeedUp.value() == Approx(1));
+  CHECK(a.find(Method::Equal)->budgets[1].speedUp->value == Approx(1));
+  CHECK(speedUpBudgets(s) == std::vector<int>{10, 20});
   CHECK(a.commonSeconds == std::vector<double>{0.1, 0.2});
 
   std::string md = summaryMarkdown(s);

@@ -63,7 +63,8 @@ std::string indexHtml(const Summary& s) {
         "the spread is the standard deviation over repeats with independent seeds.</p>\n",
         s.cases.front().info.device, fmt::join(s.budgets, ", "));
   out += fmt::format("<h2>RMSE×1000 at {} spp (000 Table 5.2 layout)</h2>\n", s.tableBudget) + html(rmseTable(s));
-  out += "<h2>Speed-up over equal at equal error (median over budgets)</h2>\n" + html(speedUpTable(s));
+  for (int budget : speedUpBudgets(s))
+    out += fmt::format("<h2>Speed-up over equal at equal error, {} spp</h2>\n", budget) + html(speedUpTable(s, budget));
   out += fmt::format("<h2>Seconds per render at {} spp: wall (kernel + allocation)</h2>\n", s.tableBudget) +
          html(timeTable(s));
   for (const CaseSummary& c : s.cases) {

@@ -50,7 +50,7 @@ BudgetStats reduceRepeats(const std::vector<const RunRecord*>& runs) {
 
 MethodSummary summarizeMethod(const Comparison& comparison, const std::string& caseLabel, Method method,
                               const std::vector<int>& budgets, int repeats) {
-  MethodSummary m{method, {}, {}, {}, {}};
+  MethodSummary m{method, {}, {}, {}};
   for (int budget : budgets) {
     std::vector<const RunRecord*> runs;
     for (const RunRecord& r : comparison.runs)
@@ -85,12 +85,7 @@ void compareAtEqualTime(CaseSummary& c) {
       m.equalTimeRmseX1000.push_back({1000 * std::sqrt(mse.value), mse.extrapolated});
     }
     if (!equalCurve) continue;
-    std::vector<double> speedUps;
-    for (BudgetStats& b : m.budgets) {
-      b.speedUp = speedUpOver(*equalCurve, {b.wallSeconds, b.mse});
-      speedUps.push_back(b.speedUp.value);
-    }
-    m.medianSpeedUp = median(speedUps);
+    for (BudgetStats& b : m.budgets) b.speedUp = speedUpOver(*equalCurve, {b.wallSeconds, b.mse});
   }
 }
 

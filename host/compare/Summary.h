@@ -18,14 +18,13 @@ struct BudgetStats {
   double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;  // medians
   double efficiency = 0;                                                              // 1/(mean MSE × median time)
   std::vector<double> meanAlpha;
-  CurveValue speedUp;  // over equal at this error (speedUpOver); 0 without equal
+  std::optional<CurveValue> speedUp;  // over equal at this error (speedUpOver); none without equal
 };
 
 struct MethodSummary {
   Method method;
-  std::vector<BudgetStats> budgets;  // ascending
-  std::optional<double> slope;       // log MSE against log t (−1: Monte Carlo)
-  std::optional<double> medianSpeedUp;
+  std::vector<BudgetStats> budgets;            // ascending
+  std::optional<double> slope;                 // log MSE against log t (−1: Monte Carlo)
   std::vector<CurveValue> equalTimeRmseX1000;  // at CaseSummary::commonSeconds
 
   ErrorCurve curve() const;

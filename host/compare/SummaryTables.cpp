@@ -61,10 +61,11 @@ std::pair<std::string, double> rmseCell(const Summary& s, const CaseSummary& c, 
   return {fmt::format("{:.2f} ± {:.2f}", b->rmseX1000, b->rmseSpreadX1000), b->rmseX1000};
 }
 
-std::pair<std::string, double> speedUpCell(const CaseSummary& c, Method m) {
+std::pair<std::string, double> speedUpCell(const CaseSummary& c, Method m, int budget) {
   const MethodSummary* ms = c.find(m);
-  if (!ms || !ms->medianSpeedUp) return {"–", kNone};
-  return {fmt::format("{:.2f}×", *ms->medianSpeedUp), *ms->medianSpeedUp};
+  const BudgetStats* b = ms ? ms->at(budget) : nullptr;
+  if (!b || !b->speedUp) return {"–", kNone};
+  return {(b->speedUp->extrapolated ? "~" : "") + fmt::format("{:.2f}×", b->speedUp->value), b->speedUp->value};
 }
 
 std::pair<std::string, double> timeCell(const Summary& s, const CaseSummary& c, Method m) {
@@ -91,7 +92,7 @@ nlohmann::json budgetJson(const BudgetStats& b) {
             {"host", b.hostSeconds}}},
           {"efficiency", b.efficiency},
           {"mean_alpha", b.meanAlpha},
-          {"speed_up_over_equal", curveValueJson(b.speedUp)}};
+          {"speed_up_over_equal", b.speedUp ? curveValueJson(*b.speedUp) : nlohmann::json()}};
 }
 
 }  // namespace
@@ -100,7 +101,9 @@ TextTable rmseTable(const Summary& s) {
   return methodTable(s, true, [&](const CaseSummary& c, Method m) { return rmseCell(s, c, m); });
 }
 
-TextTable speedUpTable(const Summary& s) { return methodTable(s, false, speedUpCell); }
+TextTable speedUpTable(const Summary& s, int budget) {
+  return methodTable(s, false, [&](const CaseSummary& c, Method m) { return speedUpCell(c, m, budget); });
+}
 
 TextTable timeTable(const Summary& s) {
   return methodTable(s, true, [&](const CaseSummary& c, Method m) { return timeCell(s, c, m); });
@@ -145,6 +148,11 @@ std::string html(const TextTable& table) {
   return out + "</table>\n";
 }
 
+std::vector<int> speedUpBudgets(const Summary& s) {
+  if (s.budgets.back() == s.tableBudget) return {s.tableBudget};
+  return {s.tableBudget, s.budgets.back()};
+}
+
 std::string formatCurveValue(const CurveValue& v, int decimals) {
   return (v.extrapolated ? "~" : "") + fmt::format("{:.{}f}", v.value, decimals);
 }
@@ -166,11 +174,14 @@ std::string summaryMarkdown(const Summary& s) {
       "×1000, as the mean over repeats ± their spread (sample standard deviation). Bold: the best of the column.\n\n",
       s.tableBudget);
   out += markdown(rmseTable(s));
-  out +=
-      "\n## Speed-up over equal at equal error\n\nHow many times longer `equal` needs to reach the error each method "
-      "reaches, in wall-clock time per render (sampling, allocation and host); the median over the budgets. Above 1: "
-      "the method pays off.\n\n";
-  out += markdown(speedUpTable(s));
+  for (int budget : speedUpBudgets(s)) {
+    out += fmt::format(
+        "\n## Speed-up over equal at equal error, {} spp\n\nHow many times longer `equal` needs to reach the error "
+        "each method reaches with {} spp, in wall-clock time per render (sampling, allocation and host). Above 1: the "
+        "method pays off; `~`: read off `equal`'s curve past its measured range.\n\n",
+        budget, budget);
+    out += markdown(speedUpTable(s, budget));
+  }
   out += fmt::format(
       "\n## Time per render at {} spp\n\nWall seconds (sampling kernels + allocation); the rest is host "
       "work.\n\n",
@@ -206,10 +217,11 @@ std::string budgetsCsv(const Summary& s) {
   for (const CaseSummary& c : s.cases)
     for (const MethodSummary& m : c.methods)
       for (const BudgetStats& b : m.budgets)
-        out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
-                           c.info.label, methodName(m.method), b.budget, b.repeats, b.rmseX1000, b.rmseSpreadX1000,
-                           b.relativeMse, b.wallSeconds, b.kernelSeconds, b.allocationSeconds, b.hostSeconds,
-                           b.efficiency, b.speedUp.value, b.speedUp.extrapolated ? 1 : 0);
+        out += fmt::format("{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{}\n", c.info.label,
+                           methodName(m.method), b.budget, b.repeats, b.rmseX1000, b.rmseSpreadX1000, b.relativeMse,
+                           b.wallSeconds, b.kernelSeconds, b.allocationSeconds, b.hostSeconds, b.efficiency,
+                           b.speedUp ? fmt::format("{:.6g}", b.speedUp->value) : "",
+                           b.speedUp ? (b.speedUp->extrapolated ? "1" : "0") : "");
   return out;
 }
 
@@ -221,12 +233,10 @@ nlohmann::json summaryJson(const Summary& s) {
       nlohmann::json budgets = nlohmann::json::array(), equalTime = nlohmann::json::array();
       for (const BudgetStats& b : m.budgets) budgets.push_back(budgetJson(b));
       for (const CurveValue& v : m.equalTimeRmseX1000) equalTime.push_back(curveValueJson(v));
-      methods.push_back(
-          {{"method", methodName(m.method)},
-           {"budgets", budgets},
-           {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
-           {"median_speed_up_over_equal", m.medianSpeedUp ? nlohmann::json(*m.medianSpeedUp) : nlohmann::json()},
-           {"equal_time_rmse_x1000", equalTime}});
+      methods.push_back({{"method", methodName(m.method)},
+                         {"budgets", budgets},
+                         {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
+                         {"equal_time_rmse_x1000", equalTime}});
     }
     cases.push_back({{"label", c.info.label},
                      {"scene", c.info.scene},

@@ -22,9 +22,13 @@ std::string markdown(const TextTable& table);
 std::string html(const TextTable& table);
 
 // Rows = methods, columns = scenes (000 Table 5.2): RMSE×1000 at the table budget as
-// mean ± spread; the median speed-up over equal at equal error; the time per render.
+// mean ± spread; the speed-up over equal at equal error at one budget; the time per
+// render.
 TextTable rmseTable(const Summary& summary);
-TextTable speedUpTable(const Summary& summary);
+TextTable speedUpTable(const Summary& summary, int budget);
+// The budgets the summaries give speed-ups at: the table budget and the largest, where
+// the fixed costs of the adaptive methods weigh least.
+std::vector<int> speedUpBudgets(const Summary& summary);
 TextTable timeTable(const Summary& summary);
 // One scene: each method's RMSE×1000 at equal's render times (ErrorCurve::mseAt).
 TextTable equalTimeTable(const CaseSummary& scene);

@@ -29,6 +29,11 @@ HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize);
 }
 
+void HostSampler::clearSums() {
+  std::fill(stats_.begin(), stats_.end(), 0.0);
+  if (gridSearch_) gridSearch_->reset();
+}
+
 StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
   const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
   const int firstSlot = takeSlots(plan);

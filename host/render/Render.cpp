@@ -207,6 +207,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   auto start = Clock::now();
   const Scene& scene = sampler.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
+  sampler.reset();
   Rendering out;
   Progress progress{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
                     std::vector<int>(size_t(pixels) * M, 0),

@@ -41,7 +41,7 @@ struct Rendering {
 
 // Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods
 // in a pilot and `stages` batches. The sampler must keep what the method needs
-// (samplerConfigFor).
+// (samplerConfigFor); whatever it took before is forgotten (StageSampler::reset).
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
 
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);

@@ -64,6 +64,11 @@ GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, G
   return result;
 }
 
+void StageSampler::reset() {
+  taken_ = searched_ = 0;
+  clearSums();
+}
+
 std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
   const int M = scene.techniqueCount();
   std::vector<float> samples((size_t(scene.pixelCount()) + 15) / 16 * 16 * size_t(capacity) * size_t(M + 2), 1.0f);
@@ -195,6 +200,12 @@ std::vector<double> Sampler::statistics() {
   const size_t n = size_t(scene_.pixelCount()) * statSlots();
   if (n == 0) return {};
   return doubleSums_ ? readSums<double>(device_, stats_, n) : readSums<float>(device_, stats_, n);
+}
+
+void Sampler::clearSums() {
+  const size_t bytes = size_t(scene_.pixelCount()) * statSlots() * (doubleSums_ ? sizeof(double) : sizeof(float));
+  if (bytes > 0) device_.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, bytes);
+  if (gridSearch_) gridSearch_->reset();
 }
 
 GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) {

@@ -28,6 +28,9 @@ class StageSampler {
   // the searches keep running sums, and each adds the samples of the stages since the
   // one before (kernels/gridsearch.cl on a device, its C++ reference on the host).
   GridSearchResult searchWeights(const std::vector<double>& costs, GridRule rule);
+  // Forgets every stage taken so far (running sums, the grid searches' sums), so that
+  // the next stage starts a new render on the same compiled kernels.
+  void reset();
 
   const Scene& scene() const { return scene_; }
   const SamplerConfig& config() const { return config_; }
@@ -42,6 +45,7 @@ class StageSampler {
   int takeSlots(const StagePlan& plan);
   virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs,
                                   GridRule rule) = 0;
+  virtual void clearSums() = 0;
 
   const Scene& scene_;
   SamplerConfig config_;
@@ -66,6 +70,7 @@ class Sampler : public StageSampler {
 
  private:
   GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override;
+  void clearSums() override;
 
   const Device& device_;
   std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
@@ -88,6 +93,7 @@ class HostSampler : public StageSampler {
   GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override {
     return gridSearch_->run(samples_, layout, costs, rule);
   }
+  void clearSums() override;
 
   std::vector<double> stats_;
   std::vector<float> samples_;
