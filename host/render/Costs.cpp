@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Error.h"
@@ -12,16 +13,27 @@ namespace misalloc {
 std::vector<double> measureCosts(StageSampler& calibration, int spp) {
   const Scene& scene = calibration.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
-  std::vector<double> costs(M);
+  std::vector<StagePlan> plans(M);
   for (int k = 0; k < M; ++k) {
-    StagePlan plan;
+    StagePlan& plan = plans[k];
     plan.techniqueCount = M;
     plan.stageSamples = spp;
     plan.counts.assign(size_t(pixels) * M, 0);
     plan.firstIndex.assign(size_t(pixels) * M, 0u);
     for (int p = 0; p < pixels; ++p) plan.counts[size_t(p) * M + k] = spp;
     calibration.run(plan, 1);  // the first launch of a kernel pays for its JIT
-    costs[k] = calibration.run(plan, 2).kernelSeconds / (double(pixels) * spp);
+  }
+  // Rounds over the techniques in turn, so that a drift of the machine's speed
+  // reaches every technique alike, and the median round of each, which a round
+  // slowed by another process does not move.
+  constexpr int kRounds = 5;
+  std::vector<std::vector<double>> seconds(M);
+  for (int round = 0; round < kRounds; ++round)
+    for (int k = 0; k < M; ++k) seconds[k].push_back(calibration.run(plans[k], 2 + round).kernelSeconds);
+  std::vector<double> costs(M);
+  for (int k = 0; k < M; ++k) {
+    std::nth_element(seconds[k].begin(), seconds[k].begin() + kRounds / 2, seconds[k].end());
+    costs[k] = seconds[k][kRounds / 2] / (double(pixels) * spp);
   }
   return costs;
 }
