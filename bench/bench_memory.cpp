@@ -38,9 +38,6 @@ struct Config {
   int size = 256, spp = 200;
 } config;
 
-const Method kMethods[] = {Method::Envmap,     Method::Brdf,   Method::Equal, Method::Heuristic,
-                           Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
-
 enum class Peer { OpenCl, OpenMp };
 
 // What one child reports: the sampler's sizes and the bytes it measured.
@@ -172,11 +169,11 @@ int main(int argc, char** argv) {
                     {"--size", [](const char* v) { config.size = std::stoi(v); }},
                     {"--spp", [](const char* v) { config.spp = std::stoi(v); }}});
   // [method][peer][small, large]
-  std::vector<std::array<std::array<Footprint, 2>, 2>> footprints(std::size(kMethods));
+  std::vector<std::array<std::array<Footprint, 2>, 2>> footprints(allMethods().size());
   for (size_t i = 0; i < footprints.size(); ++i)
     for (Peer peer : {Peer::OpenCl, Peer::OpenMp})
       for (int large : {0, 1})
-        footprints[i][int(peer)][large] = measureInChild(peer, kMethods[i], large ? config.size : config.size / 2);
+        footprints[i][int(peer)][large] = measureInChild(peer, allMethods()[i], large ? config.size : config.size / 2);
   const std::string device = footprints[0][0][1].device;
   const int M = footprints[0][0][1].techniqueCount;
   const nlohmann::json sizes = {
@@ -197,7 +194,7 @@ int main(int argc, char** argv) {
   bench::PeerTable fixed{"Measured peak resident-set growth, fixed part (independent of pixels), " + measured, "method",
                          "MB", sizes, false};
   for (size_t i = 0; i < footprints.size(); ++i) {
-    const std::string name = methodName(kMethods[i]);
+    const std::string name = methodName(allMethods()[i]);
     const auto& [cl, mp] = footprints[i];
     const Footprint& api = cl[1];
     const double sums = api.statSlots * sizeof(double), stored = api.storedFloats * sizeof(float);

@@ -131,9 +131,7 @@ AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
 
 // "all" or a comma-separated list of method names, each once.
 std::vector<Method> parseMethodList(const std::string& list) {
-  if (list == "all")
-    return {Method::Envmap,     Method::Brdf,   Method::Equal, Method::Heuristic,
-            Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
+  if (list == "all") return allMethods();
   std::vector<Method> methods;
   std::stringstream items(list);
   for (std::string item; std::getline(items, item, ',');) {

@@ -14,6 +14,11 @@ typedef struct {
   ma_uint first0, first1, first2;  // index of each technique's first sample this stage
 } StageCounts;
 
+// The index of `technique`'s first sample this stage (its random-number stream).
+MA_FN ma_uint firstIndexOf(StageCounts c, int technique) {
+  return technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
+}
+
 typedef struct {
   int technique;
   float r, g, b;  // the sample's term of the stage estimate
@@ -82,8 +87,7 @@ MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongP
   } else {
     technique = j < c.n0 ? 0 : (j < c.n0 + c.n1 ? 1 : 2);
     int start = technique == 0 ? 0 : (technique == 1 ? c.n0 : c.n0 + c.n1);
-    ma_uint first = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
-    index = first + (ma_uint)(j - start);
+    index = firstIndexOf(c, technique) + (ma_uint)(j - start);
   }
   return takeTechniqueSample(ts, env, b, c, technique, index, seedLo, seedHi, pixel);
 }

@@ -60,8 +60,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 #if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
 #else
-  uint firstOfTechnique = technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);
-  return takeTechniqueSample(ts, env, b, c, technique, firstOfTechnique + (uint)j, seedLo, seedHi, (uint)pixel);
+  return takeTechniqueSample(ts, env, b, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo, seedHi,
+                             (uint)pixel);
 #endif
 }
 

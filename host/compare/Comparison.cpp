@@ -55,11 +55,7 @@ nlohmann::json runJson(const RunRecord& r) {
           {"spp", r.budget},
           {"repeat", r.repeat},
           {"seed", r.seed},
-          {"time_s",
-           {{"wall", r.wallSeconds},
-            {"kernel", r.kernelSeconds},
-            {"allocation", r.allocationSeconds},
-            {"host", r.hostSeconds}}},
+          {"time_s", timeSplitJson(r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds)},
           {"rmse_x1000", 1000 * std::sqrt(r.mse)},
           {"relative_mse", r.relativeMse},
           {"efficiency", r.efficiency()},
@@ -164,16 +160,17 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
     for (Method method : options.methods)
-      for (int budget : options.budgets)
+      for (int budget : options.budgets) {
+        // Built (and its kernels compiled) once; each render starts it afresh.
+        auto sampler =
+            makeStageSampler(options.device, device, scene,
+                             samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize);
         for (int r = 0; r < options.repeats; ++r) {
           if (guard.requested()) {
             out.interrupted = true;
             writeRuns(options.outDir, out);
             return out;
           }
-          auto sampler =
-              makeStageSampler(options.device, device, scene,
-                               samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize);
           const uint64_t seed = options.seed + uint64_t(r);
           Rendering rendering = render(*sampler, method, adaptive, budget, seed);
           out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference->image));
@@ -187,6 +184,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
           writeRuns(options.outDir, out);
           meter.step(fmt::format("{} {} {} spp #{}", c.label, methodName(method), budget, r + 1));
         }
+      }
   }
   return out;
 }

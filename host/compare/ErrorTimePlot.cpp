@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace misalloc {
 namespace {
@@ -45,32 +46,32 @@ struct LogAxis {
     if (hi <= lo) hi = lo + 1;
   }
   double operator()(double v) const { return from + (std::log10(v) - lo) / (hi - lo) * (to - from); }
+  // 1, 2 and 5 times each power of ten on the axis.
+  std::vector<double> ticks() const {
+    std::vector<double> values;
+    for (double e = lo; e <= hi; ++e)
+      for (int m : {1, 2, 5})
+        if (std::log10(m) + e <= hi + 1e-9) values.push_back(m * std::pow(10.0, e));
+    return values;
+  }
 };
 
 std::string tickLabel(double value) { return fmt::format("{:g}", value); }
 
 std::string axes(const LogAxis& x, const LogAxis& y) {
   std::string svg;
-  for (double e = x.lo; e <= x.hi; ++e)
-    for (int m : {1, 2, 5}) {
-      double v = m * std::pow(10.0, e);
-      if (std::log10(v) > x.hi + 1e-9) break;
-      double px = x(v);
-      svg += fmt::format(R"(<line x1="{0:.1f}" y1="{1}" x2="{0:.1f}" y2="{2}" stroke="#ddd"/>)", px, kTop,
-                         kHeight - kBottom);
-      svg += fmt::format(R"(<text x="{:.1f}" y="{}" text-anchor="middle" font-size="11">{}</text>)", px,
-                         kHeight - kBottom + 16, tickLabel(v));
-    }
-  for (double e = y.lo; e <= y.hi; ++e)
-    for (int m : {1, 2, 5}) {
-      double v = m * std::pow(10.0, e);
-      if (std::log10(v) > y.hi + 1e-9) break;
-      double py = y(v);
-      svg += fmt::format(R"(<line x1="{0}" y1="{1:.1f}" x2="{2}" y2="{1:.1f}" stroke="#ddd"/>)", kLeft, py,
-                         kWidth - kRight);
-      svg += fmt::format(R"(<text x="{}" y="{:.1f}" text-anchor="end" font-size="11">{}</text>)", kLeft - 6, py + 4,
-                         tickLabel(v));
-    }
+  for (double v : x.ticks()) {
+    svg += fmt::format(R"(<line x1="{0:.1f}" y1="{1}" x2="{0:.1f}" y2="{2}" stroke="#ddd"/>)", x(v), kTop,
+                       kHeight - kBottom);
+    svg += fmt::format(R"(<text x="{:.1f}" y="{}" text-anchor="middle" font-size="11">{}</text>)", x(v),
+                       kHeight - kBottom + 16, tickLabel(v));
+  }
+  for (double v : y.ticks()) {
+    svg += fmt::format(R"(<line x1="{0}" y1="{1:.1f}" x2="{2}" y2="{1:.1f}" stroke="#ddd"/>)", kLeft, y(v),
+                       kWidth - kRight);
+    svg += fmt::format(R"(<text x="{}" y="{:.1f}" text-anchor="end" font-size="11">{}</text>)", kLeft - 6, y(v) + 4,
+                       tickLabel(v));
+  }
   svg += fmt::format(R"(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#000"/>)", kLeft, kTop,
                      kWidth - kLeft - kRight, kHeight - kTop - kBottom);
   svg += fmt::format(R"(<text x="{}" y="{}" text-anchor="middle" font-size="13">wall time per render (s)</text>)",

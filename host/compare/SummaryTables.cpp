@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "render/Report.h"
+
 namespace misalloc {
 namespace {
 
@@ -85,11 +87,7 @@ nlohmann::json budgetJson(const BudgetStats& b) {
           {"rmse_x1000", b.rmseX1000},
           {"rmse_spread_x1000", b.rmseSpreadX1000},
           {"relative_mse", b.relativeMse},
-          {"time_s",
-           {{"wall", b.wallSeconds},
-            {"kernel", b.kernelSeconds},
-            {"allocation", b.allocationSeconds},
-            {"host", b.hostSeconds}}},
+          {"time_s", timeSplitJson(b.wallSeconds, b.kernelSeconds, b.allocationSeconds, b.hostSeconds)},
           {"efficiency", b.efficiency},
           {"mean_alpha", b.meanAlpha},
           {"speed_up_over_equal", b.speedUp ? curveValueJson(*b.speedUp) : nlohmann::json()}};

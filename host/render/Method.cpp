@@ -34,6 +34,12 @@ std::string availableMethods() {
 
 }  // namespace
 
+const std::vector<Method>& allMethods() {
+  static const std::vector<Method> methods{Method::Envmap,     Method::Brdf,   Method::Equal, Method::Heuristic,
+                                           Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
+  return methods;
+}
+
 Method parseMethod(const std::string& name) {
   for (const auto& m : kMethods)
     if (name == m.name) return m.method;

@@ -13,6 +13,9 @@ namespace misalloc {
 // probe finds best (render/Render.h).
 enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle };
 
+// Every method, in the order of the tables (000 Table 5.2's rows, then ours).
+const std::vector<Method>& allMethods();
+
 // Throws InputError for an unknown name.
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);

@@ -32,6 +32,10 @@ nlohmann::json sceneJson(const Scene& scene) {
           {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"}};
 }
 
+nlohmann::json timeSplitJson(double wall, double kernel, double allocation, double host) {
+  return {{"wall", wall}, {"kernel", kernel}, {"allocation", allocation}, {"host", host}};
+}
+
 nlohmann::json renderReport(const RenderRun& run) {
   const Rendering& r = run.rendering;
   const int pixels = run.scene.pixelCount(), M = run.scene.techniqueCount();
@@ -52,11 +56,7 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"spp", run.spp},
       {"seed", run.seed},
       {"device", run.device},
-      {"time_s",
-       {{"wall", r.wallSeconds},
-        {"kernel", r.kernelSeconds},
-        {"allocation", r.allocationSeconds},
-        {"host", r.hostSeconds}}},
+      {"time_s", timeSplitJson(r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds)},
       {"samples_per_second", double(pixels) * run.spp / r.kernelSeconds},
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
       {"mean_alpha", meanAlpha},

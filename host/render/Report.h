@@ -29,6 +29,10 @@ nlohmann::json renderReport(const RenderRun& run);
 
 nlohmann::json sceneJson(const Scene& scene);
 
+// The "time_s" object of every report: wall seconds split into sampling kernels,
+// allocation and host work.
+nlohmann::json timeSplitJson(double wall, double kernel, double allocation, double host);
+
 std::string estimatorName(Estimator estimator);
 
 }  // namespace misalloc
