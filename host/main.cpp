@@ -85,6 +85,12 @@ struct AdaptiveArgs {
     app->add_option("--pilot", options.pilotFraction, "adaptive methods: the pilot's share of the budget")
         ->capture_default_str();
     app->add_option("--stages", options.stages, "adaptive methods: stages after the pilot")->capture_default_str();
+    app->add_option("--pool", options.poolRadius,
+                    "adaptive methods: allocate from the statistics of the (2R+1)^2 pixels around each pixel")
+        ->capture_default_str();
+    app->add_option("--skip-below", options.minGain,
+                    "exact: keep equal counts where the predicted gain of adapting is below this fraction")
+        ->capture_default_str();
     app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
     app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
         ->capture_default_str();

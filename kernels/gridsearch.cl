@@ -54,6 +54,32 @@ MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alp
   }
 }
 
+// Rule (b)'s sums over the n prepared samples of a batch with technique fractions
+// stageMix (kernels/gridsearch.h, costVarianceScore): M_j += g r_j into sumM[j] and
+// S2 += g w into sumS2, for the combinations l0 … l0 + MA_PASS − 1.
+MA_FN void sumMixture(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
+                      const float* stageMix, float16 sumM[MA_TECHNIQUES][MA_GRID_VECTORS], float16* sumS2) {
+  for (int i = 0; i < n; ++i) {
+    __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
+    float r[MA_TECHNIQUES];
+    float w = mixtureWeights(MA_TECHNIQUES, stageMix, x, r);
+    float16 p[MA_GRID_VECTORS], g[MA_GRID_VECTORS];
+    MA_UNROLL
+    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+      p[v] = alpha[v][0] * x[1];
+      MA_UNROLL
+      for (int k = 1; k < MA_TECHNIQUES; ++k) p[v] = fma(alpha[v][k], (float16)x[1 + k], p[v]);
+    }
+    MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x[0], p, g);
+    MA_UNROLL
+    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+      sumS2[v] = fma(g[v], (float16)w, sumS2[v]);
+      MA_UNROLL
+      for (int j = 0; j < MA_TECHNIQUES; ++j) sumM[j][v] = fma(g[v], (float16)r[j], sumM[j][v]);
+    }
+  }
+}
+
 // The best of 16 candidates (score, index) per lane: the highest score, ties to the
 // lowest index, as a scan in index order would keep it. NaN scores never win, nor do
 // the copies that pad the grid: they share a batch of quotients with other
@@ -115,9 +141,11 @@ MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const 
 // takes its logarithms one combination at a time.
 MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelSummary all, float rescale,
                       __global float* sums, int rank, __global const float* gridLanes, __global const float* gridCost,
-                      int gridSize, int paddedSize, const float* cost, int rule) {
-  float invCount[MA_TECHNIQUES];
+                      int gridSize, int paddedSize, const float* cost, int rule, __global float* scores) {
+  float invCount[MA_TECHNIQUES], stageMix[MA_TECHNIQUES];
   for (int j = 0; j < MA_TECHNIQUES; ++j) invCount[j] = 1.0f / all.count[j];
+  const float invTotal = 1.0f / sampleCount(MA_TECHNIQUES, all);
+  stageMixture(MA_TECHNIQUES, added, stageMix);
   const int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   LaneBest best = {(float16)(-INFINITY), (int16)(-1)};
   for (int l0 = 0; l0 < gridSize; l0 += MA_PASS) {
@@ -125,12 +153,15 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
     for (int v = 0; v < MA_GRID_VECTORS; ++v)
       for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[v][k] = vload16(0, gridLanes + k * paddedSize + l0 + 16 * v);
     float16 sumG[MA_TECHNIQUES][MA_GRID_VECTORS], sumG2[MA_TECHNIQUES][MA_GRID_VECTORS];
-    for (int j = 0; j < MA_TECHNIQUES; ++j) {
-      loadSums(sums, j, l0, paddedSize, rescale, sumG[j], sumG2[j]);
-      sumTechnique(prepared + preparedFirst(added, j) * (MA_TECHNIQUES + 1), added.nonZero[j], alpha, sumG[j],
-                   sumG2[j]);
-      storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
+    for (int j = 0; j < MA_TECHNIQUES; ++j) loadSums(sums, j, l0, paddedSize, rescale, sumG[j], sumG2[j]);
+    if (rule == MA_RULE_MAX_ENTROPY) {
+      for (int j = 0; j < MA_TECHNIQUES; ++j)
+        sumTechnique(prepared + preparedFirst(added, j) * (MA_TECHNIQUES + 1), added.nonZero[j], alpha, sumG[j],
+                     sumG2[j]);
+    } else {
+      sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES), alpha, stageMix, sumG, sumG2[0]);
     }
+    for (int j = 0; j < MA_TECHNIQUES; ++j) storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
     if (!rank) continue;
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       float16 g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
@@ -158,8 +189,9 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
         }
         score = vload16(0, h);
       } else {
-        score = costVarianceScore16(MA_TECHNIQUES, alpha[v], vload16(0, gridCost + l0 + 16 * v), g1, g2, invCount);
+        score = costVarianceScore16(MA_TECHNIQUES, alpha[v], vload16(0, gridCost + l0 + 16 * v), g1, g2[0], invTotal);
       }
+      vstore16(score, 0, scores + l0 + 16 * v);
       keepBetter(&best, score, index, gridSize);
     }
   }
@@ -171,13 +203,16 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
 // searches before added. gridLanes[k · paddedSize + l] = α_{k,l} and gridCost[l] =
 // Σ_k c_k α_{k,l}, both padded past gridSize with the last combination; cost[k] = c_k;
 // `prepared` has taken · (M + 1) floats per pixel (prepareSample). Outputs per pixel: α
-// (M floats), the selected index l₀ (−1 where the pixel fell back to equal weights) and
-// AllocationFallback bits.
+// (M floats), the selected index l₀ (−1 where the pixel fell back to equal weights),
+// AllocationFallback bits, the score of every combination (paddedSize floats; written
+// where the pixel did not fall back) and the scale of its sums (sampleScale), so that
+// the host can pool the scores of neighbouring pixels (host/alloc/PooledSelection.h).
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
                          __global const float* gridLanes, __global const float* gridCost, int gridSize, int paddedSize,
                          __global const float* cost, int rule, __global float* prepared,
                          __global PixelSummary* summaries, __global float* sums, __global float* alphaOut,
-                         __global int* selectedOut, __global uint* fallbacksOut) {
+                         __global int* selectedOut, __global uint* fallbacksOut, __global float* scoresOut,
+                         __global float* scaleOut) {
   int block = (int)get_global_id(0);
   if (16 * block >= pixelCount) return;
   const int lanesUsed = min(16, pixelCount - 16 * block);
@@ -214,7 +249,7 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
     if (hasSums(all[lane]))
       best = searchPixel(blockPrepared + lane * taken * (MA_TECHNIQUES + 1), added[lane], all[lane], rescale[lane],
                          sums + runningSumIndex(pixel, 0, 0, 0, MA_TECHNIQUES, paddedSize), fallbacks[lane] == 0u,
-                         gridLanes, gridCost, gridSize, paddedSize, c, rule);
+                         gridLanes, gridCost, gridSize, paddedSize, c, rule, scoresOut + (size_t)pixel * paddedSize);
     // No combination could be ranked: non-finite sums, or for rule (a) no λ that
     // is a distribution (eq. 4.16 has no solution on the grid).
     if (fallbacks[lane] == 0u && best < 0)
@@ -224,6 +259,75 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
           fallbacks[lane] == 0u ? gridLanes[k * paddedSize + best] : 1.0f / MA_TECHNIQUES;
     selectedOut[pixel] = fallbacks[lane] == 0u ? best : -1;
     fallbacksOut[pixel] = fallbacks[lane];
+    scaleOut[pixel] = scale[lane];
     summaries[pixel] = all[lane];
   }
+}
+
+// The pooled score of combination l for the window w: Σ_q score_q,l · (scaleMin/scale_q)²
+// over the window's ranked pixels q, in row-major order, as one fma chain.
+MA_FN float pooledScore(__global const float* scores, __global const float* scales, __global const uint* fallbacks,
+                        PoolWindow w, int width, int paddedSize, float scaleMin, int l) {
+  float sum = 0.0f;
+  for (int y = w.y0; y <= w.y1; ++y)
+    for (int x = w.x0; x <= w.x1; ++x) {
+      int q = y * width + x;
+      if (fallbacks[q] == 0u) sum = fma(scores[(size_t)q * paddedSize + l], poolingFactor(scaleMin, scales[q]), sum);
+    }
+  return sum;
+}
+
+// [HS14] Alg. 1 line 13, rule (b), over every pixel's window of `radius` (kernels/gridsearch.h,
+// poolWindow), and the skip rule; one work-item per pixel. Reads gridSearch's outputs:
+// the scores, scales, and its α, l₀ and fallbacks (alpha, selected, fallbacks), which a
+// pixel with no ranked pixel in its window keeps. Writes α, l₀ (−1 where the pixel fell
+// back or skipped) and the fallback and skip flags.
+__kernel void selectPooled(__global const float* scores, __global const float* scales, __global const float* alpha,
+                           __global const int* selected, __global const uint* fallbacks, int width, int height,
+                           int radius, __global const float* gridLanes, int gridSize, int paddedSize, int equal,
+                           float minGain, __global float* alphaOut, __global int* selectedOut,
+                           __global uint* fallbacksOut, __global uchar* skippedOut) {
+  int pixel = (int)get_global_id(0);
+  if (pixel >= width * height) return;
+  PoolWindow w = poolWindow(pixel, width, height, radius);
+  float scaleMin = INFINITY;
+  for (int y = w.y0; y <= w.y1; ++y)
+    for (int x = w.x0; x <= w.x1; ++x)
+      if (fallbacks[y * width + x] == 0u) scaleMin = fmin(scaleMin, scales[y * width + x]);
+  int best = -1, skipped = 0;
+  if (scaleMin < INFINITY) {
+    const int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    LaneBest top = {(float16)(-INFINITY), (int16)(-1)};
+    for (int l0 = 0; l0 < gridSize; l0 += 16) {
+      float16 sum = 0.0f;
+      for (int y = w.y0; y <= w.y1; ++y)
+        for (int x = w.x0; x <= w.x1; ++x) {
+          int q = y * width + x;
+          if (fallbacks[q] == 0u)
+            sum = fma(vload16(0, scores + (size_t)q * paddedSize + l0), (float16)poolingFactor(scaleMin, scales[q]), sum);
+        }
+      keepBetter(&top, sum, l0 + lanes, gridSize);
+    }
+    best = bestIndex(top);
+    float sumD = 0.0f, sumD2 = 0.0f, count = 0.0f;
+    for (int y = w.y0; y <= w.y1; ++y)
+      for (int x = w.x0; x <= w.x1; ++x) {
+        int q = y * width + x;
+        if (fallbacks[q] != 0u) continue;
+        __global const float* s = scores + (size_t)q * paddedSize;
+        float d = (s[best] - s[equal]) * poolingFactor(scaleMin, scales[q]);
+        sumD += d;
+        sumD2 = fma(d, d, sumD2);
+        count += 1.0f;
+      }
+    skipped = skipsAdapting(pooledScore(scores, scales, fallbacks, w, width, paddedSize, scaleMin, best),
+                            pooledScore(scores, scales, fallbacks, w, width, paddedSize, scaleMin, equal), minGain,
+                            sumD, sumD2, count);
+  }
+  for (int k = 0; k < MA_TECHNIQUES; ++k)
+    alphaOut[pixel * MA_TECHNIQUES + k] = best < 0 ? alpha[pixel * MA_TECHNIQUES + k]
+                                          : (skipped ? 1.0f / MA_TECHNIQUES : gridLanes[k * paddedSize + best]);
+  selectedOut[pixel] = best < 0 ? selected[pixel] : (skipped ? -1 : best);
+  fallbacksOut[pixel] = best < 0 ? fallbacks[pixel] : 0u;
+  skippedOut[pixel] = (uchar)skipped;
 }

@@ -189,27 +189,57 @@ MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount
   } while (0)
 
 // Rule (b): −(Σ_k c_k α_k) V, with V the variance of the multi-sample balance heuristic
-// for N = 1 (002 eq. 21 and Table 2; ../shared/papers/README.md, "Multi-sample"), the
-// estimator the renderer runs with the selected α: V = ∫ f²/p_α − Σ_j μ'_j²/α_j with
-// μ'_j = ∫ α_j p_j f / p_α = α_j μ_j, and ∫ f²/p_α = Σ_j α_j ν_j, so V = Σ_j α_j (ν_j − μ_j²),
-// μ_j = E_j[g] and ν_j = E_j[g²] under technique j's pdf, g = f/p_α. They are estimated
-// from technique j's m_j samples by 000 eq. 6.6 and 6.8. Cancellation can leave a
-// tiny negative ν_j − μ_j², which is 0.
+// for N = 1 ([SHS16] eq. 21 and Table 2), the estimator the renderer runs with the
+// selected α: V = ∫ f²/p_α − Σ_j α_j μ_j², μ_j = ∫ p_j f / p_α. Both integrals are
+// estimated from all n samples of the pixel at once, as a deterministic mixture: a
+// sample x_i of a batch whose technique counts are m_k was drawn from
+// q = Σ_k (m_k/m) p_k in the balance heuristic's sense, so Σ_i h(x_i)/q(x_i) estimates
+// n ∫ h whatever the allocation (docs/papers.md, [HS14] eq. 4.1–4.3). With g = f/p_α,
+// w = f/q and r_j = p_j/q: S2 = Σ_i g w estimates n ∫ f²/p_α and M_j = Σ_i g r_j estimates
+// n μ_j. Estimating every α from the same samples keeps the differences between
+// combinations free of the noise of separate per-technique estimates: two techniques
+// with the same pdf give exactly the same V for every α. Cancellation can leave a tiny
+// negative V, which is 0.
 // Defined for T = float and, in the kernel, T = float16 (16 combinations at once):
 // OpenCL C has no overloading, and the builtins in the body take either.
-#define MA_DEFINE_COST_VARIANCE_SCORE(name, T)                                                                         \
-  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const T* sumG, const T* sumG2, const float* invCount) { \
-    T variance = 0.0f;                                                                                                 \
-    for (int j = 0; j < techniqueCount; ++j) {                                                                         \
-      T mu = sumG[j] * invCount[j], nu = sumG2[j] * invCount[j];                                                       \
-      variance = ma_fma(alpha[j], ma_max(ma_fma(-mu, mu, nu), 0.0f), variance);                                        \
-    }                                                                                                                  \
-    return -(meanCost * variance);                                                                                     \
+#define MA_DEFINE_COST_VARIANCE_SCORE(name, T)                                                                   \
+  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const T* sumM, T sumS2, float invCount) {        \
+    T muTerm = 0.0f;                                                                                            \
+    for (int j = 0; j < techniqueCount; ++j) {                                                                  \
+      T mu = sumM[j] * invCount;                                                                                \
+      muTerm = ma_fma(alpha[j] * mu, mu, muTerm);                                                               \
+    }                                                                                                           \
+    return -(meanCost * ma_max(ma_fma(sumS2, (T)invCount, -muTerm), 0.0f));                                     \
   }
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore, float)
 #ifdef __OPENCL_VERSION__
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore16, float16)
 #endif
+
+// The mixture weights of a batch of new samples: r_j = p_j/q and w = f/q with
+// q = Σ_k (m_k/m) p_k (rule (b) above), from a prepared sample x (prepareSample). A
+// common power of two in x leaves both as they are.
+MA_FN float mixtureWeights(int techniqueCount, const float* stageMix, MA_GLOBAL const float* x, float* r) {
+  float q = 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) q = ma_fma(stageMix[k], x[1 + k], q);
+  float invQ = q > 0.0f ? 1.0f / q : 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) r[k] = x[1 + k] * invQ;
+  return x[0] * invQ;
+}
+
+// The technique fractions m_k/m of a batch of new samples, summarised in `added`.
+MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix) {
+  float m = 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) m += added.count[k];
+  for (int k = 0; k < techniqueCount; ++k) stageMix[k] = m > 0.0f ? added.count[k] / m : 0.0f;
+}
+
+// All samples of a pixel so far: the n of rule (b).
+MA_FN float sampleCount(int techniqueCount, PixelSummary s) {
+  float n = 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) n += s.count[k];
+  return n;
+}
 
 // Rule (a), 000 Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
 // V = Σ_j α_j ν_j − μ² (000 eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j (000 eq. 4.16)
@@ -240,11 +270,52 @@ MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost,
 }
 
 // The score of weight combination α (cost Σ_k c_k α_k = meanCost) for one pixel, from
-// the sums of g = f/p_α and g² over each technique's samples and 1/m_j. Larger is better.
+// its running sums (runningSumIndex): rule (a) reads Σ g and Σ g² over each technique's
+// samples with 1/m_j, rule (b) M_j in technique j's first row and S2 in technique 0's
+// second with 1/n. Larger is better.
 MA_FN float gridScore(int rule, int techniqueCount, const float* alpha, float meanCost, const float* cost,
-                      const float* sumG, const float* sumG2, const float* invCount) {
+                      const float* sumG, const float* sumG2, const float* invCount, float invTotal) {
   return rule == MA_RULE_MAX_ENTROPY ? entropyScore(techniqueCount, alpha, meanCost, cost, sumG, sumG2, invCount)
-                                     : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2, invCount);
+                                     : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2[0], invTotal);
+}
+
+// Pooled selection (host/alloc/Pooling.h says why): a pixel ranks the combinations by
+// the sum of its neighbours' scores, each brought from its own scale to the smallest
+// scale in the window, so that no factor exceeds 1 and the sum cannot overflow.
+MA_FN float poolingFactor(float scaleMin, float scale) {
+  float r = scaleMin / scale;
+  return r * r;
+}
+
+// The window of radius r around pixel (x, y), clipped at the image's edges.
+typedef struct {
+  int x0, x1, y0, y1;
+} PoolWindow;
+
+MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius) {
+  PoolWindow w;
+  int x = pixel % width, y = pixel / width;
+  w.x0 = x - radius < 0 ? 0 : x - radius;
+  w.x1 = x + radius > width - 1 ? width - 1 : x + radius;
+  w.y0 = y - radius < 0 ? 0 : y - radius;
+  w.y1 = y + radius > height - 1 ? height - 1 : y + radius;
+  return w;
+}
+
+// The skip rule, from the pooled scores of the best and the equal combination and the
+// sum and sum of squares of the window's `count` per-pixel differences d_q (their
+// pooled score at best minus at equal). Scores are −cost × variance ≤ 0, so the
+// predicted gain 1 − best / equal reaches minGain where best > (1 − minGain) · equal.
+// The selection maximises that gain over noisy estimates, so it must also be
+// significant: Σ d_q more than MA_SKIP_Z standard errors above 0, the d_q taken as
+// independent draws (a one-sided t-test; a single pixel cannot be tested). Adapting is
+// skipped otherwise, also for NaN and where equal weights already have no variance.
+#define MA_SKIP_Z 3.0f
+MA_FN int skipsAdapting(float best, float equal, float minGain, float sumD, float sumD2, float count) {
+  if (!(best > (1.0f - minGain) * equal)) return 1;
+  if (count < 2.0f) return 0;
+  float variance = ma_max((sumD2 - sumD * sumD / count) / (count - 1.0f), 0.0f);
+  return !(sumD * sumD > MA_SKIP_Z * MA_SKIP_Z * count * variance);
 }
 
 #endif

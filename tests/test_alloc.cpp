@@ -346,28 +346,3 @@ TEST_CASE("apportionCounts sums exactly to N by largest remainder", "[alloc]") {
   CHECK_THROWS_AS(apportionCounts({1.0}, -1), std::invalid_argument);
 }
 
-TEST_CASE("nextStageCounts drives cumulative counts towards alpha times T", "[alloc]") {
-  // 000 Sec. 5.2: a pilot of 20 + 20, then four stages of 40 samples.
-  std::vector<int> taken = {20, 20};
-  std::vector<double> alpha = {0.89, 0.11};
-  for (int stage = 1; stage <= 4; ++stage) {
-    int total = 40 + 40 * stage;
-    std::vector<int> next = nextStageCounts(taken, alpha, total);
-    REQUIRE(next[0] + next[1] == 40);
-    REQUIRE(next[0] >= 0);
-    REQUIRE(next[1] >= 0);
-    taken[0] += next[0];
-    taken[1] += next[1];
-  }
-  // The pilot's 20 samples of technique 1 exceed 0.11·200 = 22 only slightly; the
-  // schedule reaches the target to within one sample.
-  CHECK(std::abs(taken[0] - 0.89 * 200) <= 1);
-  CHECK(std::abs(taken[1] - 0.11 * 200) <= 1);
-
-  // A technique already above its target gets nothing; the others share the stage.
-  CHECK(nextStageCounts({50, 0, 0}, {0.1, 0.3, 0.6}, 80) == std::vector<int>{0, 10, 20});
-  CHECK(nextStageCounts({5, 5}, {0.5, 0.5}, 10) == std::vector<int>{0, 0});
-  CHECK_THROWS_AS(nextStageCounts({5, 5}, {0.5, 0.5}, 9), std::invalid_argument);
-  CHECK_THROWS_AS(nextStageCounts({5, -1}, {0.5, 0.5}, 20), std::invalid_argument);
-  CHECK_THROWS_AS(nextStageCounts({5}, {0.5, 0.5}, 20), std::invalid_argument);
-}

@@ -44,27 +44,4 @@ std::vector<int> apportionCounts(const std::vector<double>& alpha, int total) {
   return counts;
 }
 
-std::vector<int> nextStageCounts(const std::vector<int>& taken, const std::vector<double>& alpha, int cumulativeTotal) {
-  if (taken.size() != alpha.size())
-    throw std::invalid_argument("nextStageCounts: " + std::to_string(taken.size()) + " counts but " +
-                                std::to_string(alpha.size()) + " weights");
-  double sum = validatedSum(alpha);
-  long long takenTotal = 0;
-  for (int m : taken) {
-    if (m < 0) throw std::invalid_argument("nextStageCounts: negative count");
-    takenTotal += m;
-  }
-  if (cumulativeTotal < takenTotal)
-    throw std::invalid_argument("nextStageCounts: cumulative total " + std::to_string(cumulativeTotal) +
-                                " is below the " + std::to_string(takenTotal) + " samples already taken");
-  int stage = static_cast<int>(cumulativeTotal - takenTotal);
-  if (stage == 0) return std::vector<int>(taken.size(), 0);
-
-  std::vector<double> deficit(alpha.size());
-  for (std::size_t k = 0; k < alpha.size(); ++k)
-    deficit[k] = std::max(0.0, alpha[k] / sum * cumulativeTotal - taken[k]);
-  // Σ deficit ≥ Σ (α_k T − m_k) = stage > 0, so the deficits are valid weights.
-  return apportionCounts(deficit, stage);
-}
-
 }  // namespace misalloc

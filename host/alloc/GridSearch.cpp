@@ -32,6 +32,7 @@ constexpr int kPass = 16 * kGridVectors;
 // Work-items per group. PoCL keeps every work-item's private arrays of a group at
 // once; with the group size left to it (thousands) they overflow its stack.
 constexpr int kLocalSize = 4;
+constexpr int kPoolLocalSize = 8;  // selectPooled: one work-item per pixel
 
 void checkTechniqueCount(int techniqueCount) {
   if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
@@ -86,9 +87,58 @@ int paddedGridSize(int gridSize) { return (gridSize + kPass - 1) / kPass * kPass
 
 // Floats of running sums per pixel: Σ g and Σ g² for every technique and combination
 // of the grid makeWeightGrid makes (and validates), padded to whole passes.
+// The grid's combinations (not its costs): makeWeightGrid with unit costs.
+WeightGrid gridFor(int techniqueCount, int gridSize) {
+  return makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0));
+}
+
 std::size_t runningSumFloats(int techniqueCount, int gridSize) {
-  int size = makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0)).size();
-  return std::size_t(2) * techniqueCount * paddedGridSize(size);
+  return std::size_t(2) * techniqueCount * paddedGridSize(gridFor(techniqueCount, gridSize).size());
+}
+
+// The grid's combination nearest to α_k = 1/M, against which the skip rule weighs.
+int nearestEqual(const WeightGrid& grid) {
+  const int m = grid.techniqueCount;
+  int best = 0;
+  double bestDistance = INFINITY;
+  for (int l = 0; l < grid.size(); ++l) {
+    double d = 0;
+    for (int k = 0; k < m; ++k) d += (grid.alpha[l * m + k] - 1.0 / m) * (grid.alpha[l * m + k] - 1.0 / m);
+    if (d < bestDistance) bestDistance = d, best = l;
+  }
+  return best;
+}
+
+void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, int pixelCount) {
+  if (!pooling) return;
+  if (rule == GridRule::MaxEntropy) throw std::invalid_argument("grid search: rule (a) cannot pool its selection");
+  if (std::size_t(pooling->width) * std::size_t(std::max(0, pooling->height)) != std::size_t(pixelCount) ||
+      pooling->radius < 0 || !(pooling->minGain >= 0 && pooling->minGain < 1))
+    throw std::invalid_argument(fmt::format("grid search: pooling over {}x{} pixels, radius {}, gain {} for {} pixels",
+                                            pooling->width, pooling->height, pooling->radius, pooling->minGain,
+                                            pixelCount));
+}
+
+// Per pixel α (M floats), l₀ and fallback bits, as the kernels write them.
+struct SelectionArrays {
+  std::vector<float> alpha;
+  std::vector<int> selected;
+  std::vector<unsigned> fallbacks;
+  std::vector<unsigned char> skipped;
+};
+
+GridSearchResult toResult(const SelectionArrays& a, int m) {
+  const std::size_t pixels = a.selected.size();
+  GridSearchResult result;
+  result.selected = a.selected;
+  result.skipped = a.skipped.empty() ? std::vector<unsigned char>(pixels, 0) : a.skipped;
+  result.allocations.reserve(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const float* weights = &a.alpha[p * m];
+    result.allocations.push_back(a.fallbacks[p] != 0 ? equalFallback(m, a.fallbacks[p])
+                                                     : Allocation{std::vector<double>(weights, weights + m)});
+  }
+  return result;
 }
 
 // The grid as the passes read it: α_{k,l} at [k · paddedSize + l] and the cost per
@@ -132,6 +182,11 @@ struct SearchSetup {
 // (000 Alg. 1 line 8), the sums at `sums` (runningSumIndex) first brought to the current
 // scale: the kernel's loadSums, sumTechnique and storeSums as plain loops, with the
 // same operations in the same order.
+// Adds the new samples to the running sums at `sums` (runningSumIndex) for every
+// combination l, the sums first brought to the current scale: the kernel's loadSums,
+// sumTechnique or sumMixture and storeSums as plain loops, with the same operations in
+// the same order. Rule (a): Σ g and Σ g² of each technique's samples (000 Alg. 1 line
+// 8); rule (b): M_j and S2 (kernels/gridsearch.h, costVarianceScore).
 template <int M>
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
               float* sums) {
@@ -145,26 +200,59 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
       s[l] = rescale == 0.0f ? 0.0f : s[l] * rescale;
       s2[l] = rescale == 0.0f ? 0.0f : s2[l] * rescale2;
     }
-    const float* x = prepared + kern::preparedFirst(added, j) * (M + 1);
-    for (int i = 0; i < added.nonZero[j]; ++i, x += M + 1) {
-      for (int l0 = 0; l0 < padded; l0 += kPass) {
+  }
+  // g of sample x at the 16 combinations of lane block l0 + 16 v, batched as the kernel
+  // batches them.
+  auto quotients = [&](const float* x, int l0, int lane, float (&g)[kGridVectors]) {
+    float p[kGridVectors];
+    for (int v = 0; v < kGridVectors; ++v) {
+      int l = l0 + 16 * v + lane;
+      p[v] = alpha[l] * x[1];
+      for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
+    }
+    MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
+  };
+  if (setup.rule == MA_RULE_MAX_ENTROPY) {
+    for (int j = 0; j < M; ++j) {
+      float* s = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
+      float* s2 = sums + kern::runningSumIndex(0, j, 1, 0, M, padded);
+      const float* x = prepared + kern::preparedFirst(added, j) * (M + 1);
+      for (int i = 0; i < added.nonZero[j]; ++i, x += M + 1)
+        for (int l0 = 0; l0 < padded; l0 += kPass)
 #pragma omp simd
-        for (int lane = 0; lane < 16; ++lane) {
-          float p[kGridVectors], g[kGridVectors];
-          for (int v = 0; v < kGridVectors; ++v) {
-            int l = l0 + 16 * v + lane;
-            p[v] = alpha[l] * x[1];
-            for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
+          for (int lane = 0; lane < 16; ++lane) {
+            float g[kGridVectors];
+            quotients(x, l0, lane, g);
+            for (int v = 0; v < kGridVectors; ++v) {
+              int l = l0 + 16 * v + lane;
+              s[l] += g[v];
+              s2[l] = std::fma(g[v], g[v], s2[l]);
+            }
           }
-          MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
-          for (int v = 0; v < kGridVectors; ++v) {
-            int l = l0 + 16 * v + lane;
-            s[l] += g[v];
-            s2[l] = std::fma(g[v], g[v], s2[l]);
+    }
+    return;
+  }
+  float stageMix[M];
+  kern::stageMixture(M, added, stageMix);
+  float* sumS2 = sums + kern::runningSumIndex(0, 0, 1, 0, M, padded);
+  const float* x = prepared;
+  for (int i = 0; i < kern::preparedFirst(added, M); ++i, x += M + 1) {
+    float r[M];
+    const float w = kern::mixtureWeights(M, stageMix, x, r);
+    for (int l0 = 0; l0 < padded; l0 += kPass)
+#pragma omp simd
+      for (int lane = 0; lane < 16; ++lane) {
+        float g[kGridVectors];
+        quotients(x, l0, lane, g);
+        for (int v = 0; v < kGridVectors; ++v) {
+          int l = l0 + 16 * v + lane;
+          sumS2[l] = std::fma(g[v], w, sumS2[l]);
+          for (int j = 0; j < M; ++j) {
+            float* m = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
+            m[l] = std::fma(g[v], r[j], m[l]);
           }
         }
       }
-    }
   }
 }
 
@@ -180,11 +268,13 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   }
 }
 
-// The best l₀ by the pixel's sums (000 Alg. 1 line 13), −1 if none could be ranked.
-int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, const float* sums) {
+// The best l₀ by the pixel's sums (000 Alg. 1 line 13), −1 if none could be ranked;
+// every combination's score goes to `scores`.
+int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, const float* sums, float* scores) {
   const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
   float invCount[kMaxTechniques], bestScore = -INFINITY;
   for (int j = 0; j < m; ++j) invCount[j] = 1.0f / all.count[j];
+  const float invTotal = 1.0f / kern::sampleCount(m, all);
   int best = -1;
   for (int l = 0; l < setup.grid.size(); ++l) {
     float g1[kMaxTechniques], g2[kMaxTechniques];
@@ -193,7 +283,8 @@ int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, con
       g2[j] = sums[kern::runningSumIndex(0, j, 1, l, m, padded)];
     }
     float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(), g1,
-                                  g2, invCount);
+                                  g2, invCount, invTotal);
+    scores[l] = score;
     if (score > bestScore) {
       bestScore = score;
       best = l;
@@ -203,9 +294,10 @@ int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, con
 }
 
 // 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it: adds the
-// new samples to `summary` and the running sums at `sums`, then selects.
+// new samples to `summary` and the running sums at `sums`, then selects, writing the
+// scores and the scale of the sums.
 void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepared, kern::PixelSummary& summary,
-                 float* sums, Allocation& allocation, int& selected) {
+                 float* sums, SelectionArrays& out, float* scores, float& scale) {
   const int m = setup.layout.techniqueCount;
   const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
   kern::PixelSummary added = kern::emptySummary();
@@ -213,22 +305,82 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
   const kern::PixelSummary all = kern::mergeSummaries(summary, added);
   unsigned fallbacks = kern::pixelFallbacks(m, all);
   int best = -1;
+  scale = kern::sampleScale(all);
   // Pixels that cannot be ranked yet keep their sums for the searches to come.
   if (kern::hasSums(all)) {
-    const float scale = kern::sampleScale(all);
     int next[kMaxTechniques];
     for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(added, j);
     for (int i = 0; i < setup.layout.taken; ++i) kern::prepareSample(pixelSamples, m, i, scale, next, prepared.data());
     sumPixel(setup, added, prepared.data(), kern::sumsRescale(summary, scale), sums);
-    if (fallbacks == 0) best = bestCombination(setup, all, sums);
+    if (fallbacks == 0) best = bestCombination(setup, all, sums, scores);
   }
   if (fallbacks == 0 && best < 0)
     fallbacks = setup.rule == MA_RULE_MAX_ENTROPY ? kFallbackSingularSystem : kFallbackNonFinite;
   summary = all;
-  selected = fallbacks == 0 ? best : -1;
-  allocation = fallbacks != 0
-                   ? equalFallback(m, fallbacks)
-                   : Allocation{std::vector<double>(&setup.grid.alpha[best * m], &setup.grid.alpha[best * m] + m)};
+  out.selected[pixel] = fallbacks == 0 ? best : -1;
+  out.fallbacks[pixel] = fallbacks;
+  for (int k = 0; k < m; ++k)
+    out.alpha[std::size_t(pixel) * m + k] = fallbacks == 0 ? setup.lanes.alpha[k * setup.lanes.paddedSize + best]
+                                                           : 1.0f / m;
+}
+
+// The pooled score of combination l over window w: the kernel's pooledScore.
+float pooledScore(const std::vector<float>& scores, const std::vector<float>& scales,
+                  const std::vector<unsigned>& fallbacks, kern::PoolWindow w, int width, int paddedSize,
+                  float scaleMin, int l) {
+  float sum = 0.0f;
+  for (int y = w.y0; y <= w.y1; ++y)
+    for (int x = w.x0; x <= w.x1; ++x) {
+      int q = y * width + x;
+      if (fallbacks[q] == 0)
+        sum = std::fma(scores[std::size_t(q) * paddedSize + l], kern::poolingFactor(scaleMin, scales[q]), sum);
+    }
+  return sum;
+}
+
+// The kernel selectPooled for one pixel, with the combinations in a plain loop: each
+// combination's pooled score is the same fma chain as the kernel's lane.
+void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling, int equal,
+                       const std::vector<float>& scores, const std::vector<float>& scales, const SelectionArrays& in,
+                       int pixel, SelectionArrays& out) {
+  const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
+  kern::PoolWindow w = kern::poolWindow(pixel, pooling.width, pooling.height, pooling.radius);
+  float scaleMin = INFINITY;
+  for (int y = w.y0; y <= w.y1; ++y)
+    for (int x = w.x0; x <= w.x1; ++x)
+      if (in.fallbacks[y * pooling.width + x] == 0) scaleMin = std::fmin(scaleMin, scales[y * pooling.width + x]);
+  int best = -1, skipped = 0;
+  if (scaleMin < INFINITY) {
+    float top = -INFINITY;
+    for (int l = 0; l < setup.grid.size(); ++l) {
+      float score = pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, l);
+      if (score > top) top = score, best = l;
+    }
+    float sumD = 0.0f, sumD2 = 0.0f, count = 0.0f;
+    for (int y = w.y0; y <= w.y1; ++y)
+      for (int x = w.x0; x <= w.x1; ++x) {
+        int q = y * pooling.width + x;
+        if (in.fallbacks[q] != 0) continue;
+        const float* s = scores.data() + std::size_t(q) * padded;
+        float d = (s[best] - s[equal]) * kern::poolingFactor(scaleMin, scales[q]);
+        sumD += d;
+        sumD2 = std::fma(d, d, sumD2);
+        count += 1.0f;
+      }
+    skipped = kern::skipsAdapting(top, pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal),
+                                  float(pooling.minGain), sumD, sumD2, count);
+  }
+  for (int k = 0; k < m; ++k)
+    out.alpha[std::size_t(pixel) * m + k] = best < 0 ? in.alpha[std::size_t(pixel) * m + k]
+                                            : (skipped ? 1.0f / m : setup.lanes.alpha[k * padded + best]);
+  out.selected[pixel] = best < 0 ? in.selected[pixel] : (skipped ? -1 : best);
+  out.fallbacks[pixel] = best < 0 ? in.fallbacks[pixel] : 0u;
+  out.skipped[pixel] = (unsigned char)skipped;
+}
+
+SelectionArrays selectionArrays(int pixels, int m) {
+  return SelectionArrays{std::vector<float>(std::size_t(pixels) * m), std::vector<int>(pixels),
+                         std::vector<unsigned>(pixels), std::vector<unsigned char>(pixels, 0)};
 }
 
 }  // namespace
@@ -255,7 +407,8 @@ std::size_t StoredSampleLayout::floatCount() const {
 }
 
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize) {
-  return runningSumFloats(techniqueCount, gridSize) * sizeof(float) + sizeof(kern::PixelSummary);
+  const std::size_t scoreFloats = paddedGridSize(gridFor(techniqueCount, gridSize).size()) + 1;  // and the scale
+  return (runningSumFloats(techniqueCount, gridSize) + scoreFloats) * sizeof(float) + sizeof(kern::PixelSummary);
 }
 
 int GridSearchResult::fallbackCount() const {
@@ -270,6 +423,7 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
       buildProgram(device, "gridsearch.cl",
                    fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors));
   kernel_ = cl::Kernel(program, "gridSearch");
+  poolKernel_ = cl::Kernel(program, "selectPooled");
   // OpenCL buffers cannot be empty.
   const std::size_t pixels = std::max(1, pixelCount);
   summaries_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(kern::PixelSummary));
@@ -278,11 +432,16 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
   const std::size_t sumBytes = pixels * sumFloats * sizeof(float);
   sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
   device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
+  const std::size_t scoreBytes = pixels * paddedGridSize(gridFor(techniqueCount, gridSize).size()) * sizeof(float);
+  scores_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, scoreBytes);
+  device.queue.enqueueFillBuffer(scores_, cl_uchar(0), 0, scoreBytes);
+  scales_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(float));
   reset();
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a search of no samples, not inside the first timed one.
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
-  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, std::vector<double>(techniqueCount, 1.0));
+  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, std::vector<double>(techniqueCount, 1.0),
+      GridRule::MinCostVariance, PooledSelection{pixelCount, 1, 0, 0});
 }
 
 void GridSearch::reset() {
@@ -292,8 +451,10 @@ void GridSearch::reset() {
 }
 
 GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLayout& layout,
-                                 const std::vector<double>& costs, GridRule rule) {
+                                 const std::vector<double>& costs, GridRule rule,
+                                 const std::optional<PooledSelection>& pooling) {
   checkLayout(layout, techniqueCount_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
+  checkPooling(pooling, rule, pixelCount_);
   WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   const int m = techniqueCount_, pixels = layout.pixelCount;
   GridSearchResult result;
@@ -331,35 +492,58 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   kernel_.setArg(a++, alphaOut);
   kernel_.setArg(a++, selectedOut);
   kernel_.setArg(a++, fallbacksOut);
+  kernel_.setArg(a++, scores_);
+  kernel_.setArg(a++, scales_);
   cl::Event done;
   const int blocks = (pixels + 15) / 16;
   device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange,
                                      cl::NDRange((blocks + kLocalSize - 1) / kLocalSize * kLocalSize),
                                      cl::NDRange(kLocalSize), nullptr, &done);
   done.wait();
-  result.seconds =
-      double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-      1e-9;
+  result.seconds = eventSeconds(done);
 
-  std::vector<float> alpha(std::size_t(pixels) * m);
-  std::vector<cl_uint> fallbacks(pixels);
-  result.selected.resize(pixels);
-  device_.queue.enqueueReadBuffer(alphaOut, CL_FALSE, 0, alpha.size() * sizeof(float), alpha.data());
-  device_.queue.enqueueReadBuffer(selectedOut, CL_FALSE, 0, pixels * sizeof(cl_int), result.selected.data());
-  device_.queue.enqueueReadBuffer(fallbacksOut, CL_TRUE, 0, pixels * sizeof(cl_uint), fallbacks.data());
-  result.allocations.reserve(pixels);
-  for (int p = 0; p < pixels; ++p) {
-    const float* weights = &alpha[std::size_t(p) * m];
-    result.allocations.push_back(fallbacks[p] != 0 ? equalFallback(m, fallbacks[p])
-                                                   : Allocation{std::vector<double>(weights, weights + m)});
+  SelectionArrays out = selectionArrays(pixels, m);
+  cl::Buffer alphaFinal = alphaOut, selectedFinal = selectedOut, fallbacksFinal = fallbacksOut;
+  if (pooling) {
+    alphaFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
+    selectedFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
+    fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
+    cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
+    a = 0;
+    for (const cl::Buffer* b : {&scores_, &scales_, &alphaOut, &selectedOut, &fallbacksOut})
+      poolKernel_.setArg(a++, *b);
+    poolKernel_.setArg(a++, cl_int(pooling->width));
+    poolKernel_.setArg(a++, cl_int(pooling->height));
+    poolKernel_.setArg(a++, cl_int(pooling->radius));
+    poolKernel_.setArg(a++, gridLanes);
+    poolKernel_.setArg(a++, cl_int(grid.size()));
+    poolKernel_.setArg(a++, cl_int(lanes.paddedSize));
+    poolKernel_.setArg(a++, cl_int(nearestEqual(grid)));
+    poolKernel_.setArg(a++, cl_float(pooling->minGain));
+    for (const cl::Buffer* b : {&alphaFinal, &selectedFinal, &fallbacksFinal, &skippedOut}) poolKernel_.setArg(a++, *b);
+    cl::Event pooled;
+    device_.queue.enqueueNDRangeKernel(poolKernel_, cl::NullRange,
+                                       cl::NDRange((std::size_t(pixels) + kPoolLocalSize - 1) / kPoolLocalSize *
+                                                   kPoolLocalSize),
+                                       cl::NDRange(kPoolLocalSize), nullptr, &pooled);
+    pooled.wait();
+    result.seconds += eventSeconds(pooled);
+    device_.queue.enqueueReadBuffer(skippedOut, CL_FALSE, 0, pixels, out.skipped.data());
   }
+  device_.queue.enqueueReadBuffer(alphaFinal, CL_FALSE, 0, out.alpha.size() * sizeof(float), out.alpha.data());
+  device_.queue.enqueueReadBuffer(selectedFinal, CL_FALSE, 0, pixels * sizeof(cl_int), out.selected.data());
+  device_.queue.enqueueReadBuffer(fallbacksFinal, CL_TRUE, 0, pixels * sizeof(cl_uint), out.fallbacks.data());
+  double seconds = result.seconds;
+  result = toResult(out, m);
+  result.seconds = seconds;
   return result;
 }
 
 // What the reference keeps from run to run, as the kernel keeps it on the device.
 struct GridSearchReference::RunningSums {
   std::vector<kern::PixelSummary> summaries;
-  std::vector<float> sums;  // runningSumIndex
+  std::vector<float> sums;          // runningSumIndex
+  std::vector<float> scores, scales;  // the last search's, as the kernel keeps them
 };
 
 GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize)
@@ -374,24 +558,36 @@ GridSearchReference::~GridSearchReference() = default;
 void GridSearchReference::reset() { running_->summaries.assign(std::max(0, pixelCount_), kern::emptySummary()); }
 
 GridSearchResult GridSearchReference::run(const std::vector<float>& samples, const StoredSampleLayout& layout,
-                                          const std::vector<double>& costs, GridRule rule) {
+                                          const std::vector<double>& costs, GridRule rule,
+                                          const std::optional<PooledSelection>& pooling) {
   checkLayout(layout, techniqueCount_, pixelCount_, samples.size());
+  checkPooling(pooling, rule, pixelCount_);
   WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
-  const std::size_t pixelSums = std::size_t(2) * techniqueCount_ * setup.lanes.paddedSize;
-
-  GridSearchResult result;
-  result.allocations.resize(layout.pixelCount);
-  result.selected.resize(layout.pixelCount);
+  const int m = techniqueCount_, pixels = layout.pixelCount, padded = setup.lanes.paddedSize;
+  const std::size_t pixelSums = std::size_t(2) * m * padded;
+  std::vector<float>& scores = running_->scores;
+  std::vector<float>& scales = running_->scales;
+  scores.resize(std::size_t(pixels) * padded);
+  scales.resize(pixels);
+  SelectionArrays searched = selectionArrays(pixels, m);
   auto start = std::chrono::steady_clock::now();
 #pragma omp parallel
   {
-    std::vector<float> prepared(std::size_t(layout.taken) * (layout.techniqueCount + 1));
+    std::vector<float> prepared(std::size_t(layout.taken) * (m + 1));
 #pragma omp for schedule(dynamic, 16)
-    for (int pixel = 0; pixel < layout.pixelCount; ++pixel)
+    for (int pixel = 0; pixel < pixels; ++pixel)
       searchPixel(setup, pixel, prepared, running_->summaries[pixel], running_->sums.data() + pixel * pixelSums,
-                  result.allocations[pixel], result.selected[pixel]);
+                  searched, scores.data() + std::size_t(pixel) * padded, scales[pixel]);
   }
+  SelectionArrays selection = searched;
+  if (pooling) {
+    const int equal = nearestEqual(grid);
+#pragma omp parallel for schedule(dynamic, 64)
+    for (int pixel = 0; pixel < pixels; ++pixel)
+      selectPooledPixel(setup, *pooling, equal, scores, scales, searched, pixel, selection);
+  }
+  GridSearchResult result = toResult(selection, m);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

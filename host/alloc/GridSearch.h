@@ -7,6 +7,7 @@
 #include <CL/opencl.hpp>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "alloc/Allocation.h"
@@ -56,12 +57,27 @@ struct StoredSampleLayout {
 };
 
 // What a search keeps per pixel from run to run: Σ g and Σ g² for every technique and
-// combination (the grid padded to whole passes) and the summary of the samples.
+// combination (the grid padded to whole passes), the summary of the samples, and the
+// last search's scores and scale for the pooled selection.
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize);
 
+// Rule (b)'s selection over neighbourhoods (alloc/Pooling.h says why) and the skip
+// rule, for the pixels of a width × height image: each pixel takes the combination
+// with the least Σ_q (Σ_k c_k α_k) V_q over the ranked pixels q within `radius`, and
+// keeps equal weights where that is not at least the fraction `minGain` below its
+// value at the combination nearest to equal weights: there the predicted gain does
+// not pay for the overhead of adapting. Radius 0 and minGain 0 select as rule (b)
+// alone, but for the skip where no combination beats equal weights.
+struct PooledSelection {
+  int width = 0, height = 0;
+  int radius = 0;
+  double minGain = 0;
+};
+
 struct GridSearchResult {
-  std::vector<Allocation> allocations;  // per pixel; equal weights where it fell back
-  std::vector<int> selected;            // l₀ per pixel, −1 where it fell back
+  std::vector<Allocation> allocations;  // per pixel; equal weights where it fell back or skipped
+  std::vector<int> selected;            // l₀ per pixel, −1 where it fell back or skipped
+  std::vector<unsigned char> skipped;   // per pixel: 1 where the skip rule kept equal weights
   double seconds = 0;                   // kernel time (profiling event), or the reference's wall time
 
   int fallbackCount() const;
@@ -79,17 +95,19 @@ class GridSearch {
   GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize);
 
   // Throws std::invalid_argument for a layout that does not match M, the pixel count
-  // or the buffer, taken > capacity, or costs that makeWeightGrid rejects.
+  // or the buffer, taken > capacity, costs that makeWeightGrid rejects, or pooling
+  // with rule (a) or an image that does not match the pixel count.
   GridSearchResult run(const cl::Buffer& samples, const StoredSampleLayout& layout, const std::vector<double>& costs,
-                       GridRule rule = GridRule::MinCostVariance);
+                       GridRule rule = GridRule::MinCostVariance,
+                       const std::optional<PooledSelection>& pooling = std::nullopt);
   // Forgets the samples added so far.
   void reset();
 
  private:
   const Device& device_;
   int techniqueCount_, pixelCount_, gridSize_;
-  cl::Kernel kernel_;
-  cl::Buffer summaries_, sums_, prepared_;
+  cl::Kernel kernel_, poolKernel_;
+  cl::Buffer summaries_, sums_, prepared_, scores_, scales_;
   std::size_t preparedFloats_ = 0;
 };
 
@@ -102,7 +120,8 @@ class GridSearchReference {
   ~GridSearchReference();
 
   GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
-                       const std::vector<double>& costs, GridRule rule = GridRule::MinCostVariance);
+                       const std::vector<double>& costs, GridRule rule = GridRule::MinCostVariance,
+                       const std::optional<PooledSelection>& pooling = std::nullopt);
   void reset();
 
  private:

@@ -97,4 +97,9 @@ cl::Program buildProgram(const Device& device, const std::string& mainFile, cons
   return program;
 }
 
+double eventSeconds(const cl::Event& event) {
+  return double(event.getProfilingInfo<CL_PROFILING_COMMAND_END>() - event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+         1e-9;
+}
+
 }  // namespace misalloc

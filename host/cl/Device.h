@@ -26,6 +26,9 @@ void listDevices(std::ostream& out);
 // OpenCL platform, InputError for a spec that matches nothing.
 Device openDevice(const std::string& spec);
 
+// The device time between a command's start and end (profiling events).
+double eventSeconds(const cl::Event& event);
+
 // Builds `mainFile` (an embedded kernel source) with `options`; a failure throws
 // DeviceError carrying the build log.
 cl::Program buildProgram(const Device& device, const std::string& mainFile, const std::string& options);

@@ -45,6 +45,7 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
     for (size_t k = 0; k < M; ++k) rec.meanAlpha[k] += r.alpha[p * M + k] / double(pixels);
   rec.fallbackFraction = double(r.fallbackPixels) / double(pixels);
   rec.flooredFraction = double(r.flooredPixels) / double(pixels);
+  rec.skippedFraction = double(r.skippedPixels) / double(pixels);
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
   return rec;
 }
@@ -62,6 +63,7 @@ nlohmann::json runJson(const RunRecord& r) {
           {"mean_alpha", r.meanAlpha},
           {"fallback_pixel_fraction", r.fallbackFraction},
           {"floored_pixel_fraction", r.flooredFraction},
+          {"skipped_pixel_fraction", r.skippedFraction},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel}};
 }
 
@@ -78,12 +80,13 @@ nlohmann::json caseJson(const CaseInfo& c) {
 std::string runsCsv(const Comparison& comparison) {
   std::string csv =
       "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,relative_mse,efficiency,"
-      "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,statistics_bytes_per_pixel\n";
+      "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,skipped_pixel_fraction,"
+      "statistics_bytes_per_pixel\n";
   for (const RunRecord& r : comparison.runs)
-    csv += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+    csv += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
                        r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
                        r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.mse), r.relativeMse, r.efficiency(),
-                       r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.statisticsBytesPerPixel);
+                       r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.statisticsBytesPerPixel);
   return csv;
 }
 

@@ -44,6 +44,7 @@ struct RunRecord {
   std::vector<double> meanAlpha;  // per technique
   double fallbackFraction = 0;    // pixels where an allocation rule fell back
   double flooredFraction = 0;     // pixels whose counts were raised to one per technique
+  double skippedFraction = 0;     // pixels the skip rule kept at equal weights
   double statisticsBytesPerPixel = 0;
 
   // 1/(MSE × time): what a method buys per second.

@@ -42,7 +42,9 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
   ts.techniqueCount = M;
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
   ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
-  const int slots = statSlots(), perTechnique = MA_STATS_PER_TECHNIQUE(int(config_.statsMask), M);
+  const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
+  const int slots = plan.keepStatistics ? statSlots() : 0;
+  const int perTechnique = MA_STATS_PER_TECHNIQUE(int(config.statsMask), M);
   StageResult result;
   result.rgb.assign(size_t(pixels) * 3, 0.0);
   result.moments.assign(size_t(pixels) * M * 2, 0.0);
@@ -75,8 +77,8 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)
         if (s.technique == slot / perTechnique)
-          running[slot] += kern::statValue(int(config_.statsMask), slot % perTechnique, s);
-      if (config_.sampleCapacity > 0) {
+          running[slot] += kern::statValue(int(config.statsMask), slot % perTechnique, s);
+      if (config.sampleCapacity > 0) {
         int i = firstSlot + j;
         samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, M)] = float(s.technique);
         samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, M)] = s.y;

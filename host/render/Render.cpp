@@ -9,6 +9,7 @@
 #include "Error.h"
 #include "alloc/Apportion.h"
 #include "alloc/HeuristicAllocation.h"
+#include "alloc/Pooling.h"
 #include "alloc/SigmaAllocation.h"
 #include "render/RunningStats.h"
 
@@ -114,16 +115,26 @@ struct Progress {
   std::vector<int> taken;  // [pixel·M + k]: samples technique k took
   int samplesBefore = 0;
   std::vector<unsigned char> fellBack, floored;  // per pixel: a defensive rule was used
+  std::vector<unsigned char> skipped;            // per pixel: the skip rule kept equal weights in every stage
+
+  Progress(int pixels, int M)
+      : totals{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
+        taken(size_t(pixels) * M, 0),
+        fellBack(pixels, 0),
+        floored(pixels, 0),
+        skipped(pixels, 0) {}
 };
 
 // Runs one stage with the given counts and adds it, weighted N_b/N, to the estimate.
+// `keepStatistics` false for the last stage, which no allocation reads.
 void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples, int spp,
-               uint64_t seed) {
+               uint64_t seed, bool keepStatistics) {
   const int M = sampler.scene().techniqueCount();
   StagePlan plan;
   plan.techniqueCount = M;
   plan.stageSamples = stageSamples;
   plan.samplesBefore = progress.samplesBefore;
+  plan.keepStatistics = keepStatistics;
   plan.counts = std::move(counts);
   plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
   StageResult stage = sampler.run(plan, seed);
@@ -134,36 +145,46 @@ void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> c
   progress.samplesBefore += stageSamples;
 }
 
-// Every pixel's weights from all its samples so far.
+// Every pixel's weights from all its samples so far, the running sums pooled over
+// its neighbourhood.
 std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
-                                            int taken) {
-  if (method == Method::Exact) return sampler.searchWeights(options.costs, options.gridRule).allocations;
-  const int pixels = sampler.scene().pixelCount(), M = sampler.scene().techniqueCount(), slots = sampler.statSlots();
+                                            Progress& progress) {
+  const Scene& scene = sampler.scene();
+  if (method == Method::Exact) {
+    std::optional<PooledSelection> pooling;
+    if (options.gridRule == GridRule::MinCostVariance)
+      pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
+    GridSearchResult search = sampler.searchWeights(options.costs, options.gridRule, pooling);
+    for (size_t p = 0; p < search.skipped.size(); ++p) progress.skipped[p] &= search.skipped[p];
+    return std::move(search.allocations);
+  }
+  const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = sampler.statSlots();
   std::vector<double> stats = sampler.statistics();
+  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, options.poolRadius);
   std::vector<float> stored = methodStoresSamples(method) ? sampler.storedSamples() : std::vector<float>{};
   std::vector<Allocation> allocations(pixels);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int p = 0; p < pixels; ++p) {
     PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, sampler.config().statsMask, M);
     std::optional<PixelSamples> samples;
-    if (!stored.empty()) samples = decodePixelSamples(stored, p, taken, sampler.config().sampleCapacity, M);
+    if (!stored.empty())
+      samples = decodePixelSamples(stored, p, progress.samplesBefore, sampler.config().sampleCapacity, M);
     allocations[p] = allocatePixel(method, options, pixelStats, samples ? &*samples : nullptr);
   }
   return allocations;
 }
 
-// The next stage's counts: cumulative counts approach α·T after it (000 Alg. 1 line 15).
-// `cumulative` false: the stage alone is split by α (the oracle's single stage).
-std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocation>& allocations, int stageSamples,
-                                 bool cumulative = true) {
+// The next stage's counts: the stage split by the current α. Each stage is its own
+// balance-heuristic estimate with its own counts, weighted N_b/N, so the render's
+// variance is Σ_b (N_b/N)² V(α_b)/N_b: each stage is best split by the best α known
+// ([HS14] eq. 4.5 per stage; tests/test_adaptive.cpp compares it with making the
+// cumulative counts approach α·N).
+std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocation>& allocations, int stageSamples) {
   const int M = int(progress.taken.size() / progress.fellBack.size());
   std::vector<int32_t> out(progress.taken.size());
 #pragma omp parallel for schedule(static, 1024)
   for (size_t p = 0; p < allocations.size(); ++p) {
-    std::vector<int> taken(progress.taken.begin() + p * M, progress.taken.begin() + (p + 1) * M);
-    std::vector<int> counts = cumulative
-                                  ? nextStageCounts(taken, allocations[p].alpha, progress.samplesBefore + stageSamples)
-                                  : apportionCounts(allocations[p].alpha, stageSamples);
+    std::vector<int> counts = apportionCounts(allocations[p].alpha, stageSamples);
     progress.fellBack[p] |= allocations[p].usedFallback() ? 1 : 0;
     progress.floored[p] |= floorCounts(counts) ? 1 : 0;
     std::copy(counts.begin(), counts.end(), out.begin() + p * M);
@@ -180,11 +201,13 @@ std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
   return out;
 }
 
-// The largest stage of the schedule whatever the technique count M, which the sampler
-// config does not know: the pilot takes max(2M, f·N) ≤ max(2·kMaxTechniques, f·N)
-// samples, and the stages after it are largest after the smallest pilot, that of M = 2.
-int largestStage(const AdaptiveOptions& options, int spp) {
+// The largest stage that keeps statistics (all but the last) whatever the technique
+// count M, which the sampler config does not know: the pilot takes max(2M, f·N) ≤
+// max(2·kMaxTechniques, f·N) samples, and the stages after it are largest after the
+// smallest pilot, that of M = 2.
+int largestStatisticsStage(const AdaptiveOptions& options, int spp) {
   std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, 2);
+  sizes.pop_back();
   return std::max(*std::max_element(sizes.begin(), sizes.end()), std::min(spp, 2 * kMaxTechniques));
 }
 
@@ -195,12 +218,20 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   config.estimator = isAdaptive(method) ? methodEstimator(method) : fixedSplitEstimator;
   config.statsMask = methodStatistics(method);
   config.sampleCapacity = methodStoresSamples(method) ? spp : 0;
-  // The grid searches keep running sums: the samples of one stage at a time (the
-  // oracle's probe, then its render stage) are stored.
-  if (method == Method::Exact) config.sampleCapacity = largestStage(options, spp);
-  if (method == Method::Oracle) config.sampleCapacity = std::max(options.oracleSamples, spp);
+  // The grid searches keep running sums: the samples of one stage at a time are
+  // stored, and the last stage stores none (the oracle's: its probe only).
+  if (method == Method::Exact) config.sampleCapacity = largestStatisticsStage(options, spp);
+  if (method == Method::Oracle) config.sampleCapacity = options.oracleSamples;
   if (method == Method::Exact || method == Method::Oracle) config.gridSize = options.gridSize;
   return config;
+}
+
+void validateAdaptiveOptions(const AdaptiveOptions& options) {
+  if (options.poolRadius < 0) throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
+  if (!(options.minGain >= 0 && options.minGain < 1))
+    throw InputError(fmt::format("--skip-below {}: the gain must lie in [0, 1)", options.minGain));
+  if (options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)
+    throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
 }
 
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed) {
@@ -209,13 +240,9 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
   sampler.reset();
   Rendering out;
-  Progress progress{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
-                    std::vector<int>(size_t(pixels) * M, 0),
-                    0,
-                    std::vector<unsigned char>(pixels, 0),
-                    std::vector<unsigned char>(pixels, 0)};
+  Progress progress(pixels, M);
   if (!isAdaptive(method)) {
-    takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, spp, seed);
+    takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, spp, seed, false);
   } else if (method == Method::Oracle) {
     validateCosts(options.costs, M);
     // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
@@ -223,31 +250,35 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     // then takes the α it finds best in one stage.
     auto probeStart = Clock::now();
     takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples,
-              options.oracleSamples, ~seed);
+              options.oracleSamples, ~seed, true);
     std::vector<Allocation> best = sampler.searchWeights(options.costs, GridRule::MinCostVariance).allocations;
     out.allocationSeconds = secondsSince(probeStart);
-    Progress render{{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
-                    std::vector<int>(size_t(pixels) * M, 0),
-                    progress.samplesBefore,
-                    std::vector<unsigned char>(pixels, 0),
-                    std::vector<unsigned char>(pixels, 0)};
-    takeStage(sampler, render, stageCounts(render, best, spp, false), spp, spp, seed);
+    Progress render(pixels, M);
+    render.samplesBefore = progress.samplesBefore;
+    takeStage(sampler, render, stageCounts(render, best, spp), spp, spp, seed, false);
     progress = std::move(render);
   } else {
     validateCosts(options.costs, M);
+    validateAdaptiveOptions(options);
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
-    takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], spp, seed);
-    for (size_t b = 1; b < sizes.size(); ++b) {
-      auto allocationStart = Clock::now();
-      std::vector<Allocation> allocations = allocateFromSamples(sampler, method, options, progress.samplesBefore);
-      std::vector<int32_t> counts = stageCounts(progress, allocations, sizes[b]);
-      out.allocationSeconds += secondsSince(allocationStart);
-      takeStage(sampler, progress, std::move(counts), sizes[b], spp, seed);
+    if (method == Method::Exact && options.gridRule == GridRule::MinCostVariance)
+      std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
+    for (size_t b = 0; b < sizes.size(); ++b) {
+      std::vector<int32_t> counts;
+      if (b == 0) {
+        counts = equalCounts(pixels, M, sizes[0]);
+      } else {
+        auto allocationStart = Clock::now();
+        counts = stageCounts(progress, allocateFromSamples(sampler, method, options, progress), sizes[b]);
+        out.allocationSeconds += secondsSince(allocationStart);
+      }
+      takeStage(sampler, progress, std::move(counts), sizes[b], spp, seed, b + 1 < sizes.size());
     }
   }
   out.fallbackPixels = size_t(std::count(progress.fellBack.begin(), progress.fellBack.end(), 1));
   out.flooredPixels = size_t(std::count(progress.floored.begin(), progress.floored.end(), 1));
+  out.skippedPixels = size_t(std::count(progress.skipped.begin(), progress.skipped.end(), 1));
   out.image = RgbImage{scene.grid.width, scene.grid.height,
                        std::vector<float>(progress.totals.rgb.begin(), progress.totals.rgb.end())};
   out.variance = std::move(progress.totals.variance);

@@ -12,8 +12,10 @@ namespace misalloc {
 
 // The batched schedule of the adaptive methods (000 Algorithm 1, Sec. 5.2).
 struct AdaptiveOptions {
-  double pilotFraction = 0.2;  // of N, split equally among the techniques
-  int stages = 4;              // after the pilot
+  double pilotFraction = 0.05;  // of N, split equally among the techniques
+  int stages = 1;               // after the pilot
+  int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
+  double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/PooledSelection.h)
   std::vector<double> costs;   // c_k per sample, one per technique
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
@@ -31,6 +33,7 @@ struct Rendering {
   std::vector<double> alpha;     // [pixel·M + k]: the share of the pixel's samples technique k took
   size_t fallbackPixels = 0;     // pixels where an allocation rule fell back (alloc/Allocation.h)
   size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
+  size_t skippedPixels = 0;      // pixels that the skip rule kept at equal weights in every stage
   int stageCount = 1;
   double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
   double kernelSeconds = 0;      // device time of the sampling kernels (profiling events)

@@ -68,12 +68,16 @@ nlohmann::json renderReport(const RenderRun& run) {
     report["allocation"] = {
         {"stages", r.stageCount},
         {"pilot_fraction", run.adaptive.pilotFraction},
+        {"pool_radius", run.adaptive.poolRadius},
+        {"skip_below", run.adaptive.minGain},
         {"costs_s_per_sample", costs},
         {"costs_source", run.costSource},
         {"fallback_pixels", r.fallbackPixels},
         {"fallback_pixel_fraction", double(r.fallbackPixels) / pixels},
         {"floored_pixels", r.flooredPixels},
         {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
+        {"skipped_pixels", r.skippedPixels},
+        {"skipped_pixel_fraction", double(r.skippedPixels) / pixels},
     };
     if (run.method == Method::Exact || run.method == Method::Oracle) {
       report["allocation"]["grid_u"] = run.adaptive.gridSize;

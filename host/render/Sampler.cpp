@@ -46,6 +46,11 @@ size_t StageSampler::searchBytesPerPixel() const {
 }
 
 int StageSampler::takeSlots(const StagePlan& plan) {
+  if (closed_) throw std::logic_error("a stage after the stage without statistics");
+  if (!plan.keepStatistics) {
+    closed_ = true;
+    return 0;
+  }
   const int slot = plan.samplesBefore - searched_;
   if (slot < 0) throw std::logic_error("stage overwrites samples the grid search already added");
   if (config_.sampleCapacity > 0 && slot + plan.stageSamples > config_.sampleCapacity)
@@ -54,18 +59,20 @@ int StageSampler::takeSlots(const StagePlan& plan) {
   return slot;
 }
 
-GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, GridRule rule) {
+GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, GridRule rule,
+                                             const std::optional<PooledSelection>& pooling) {
   if (config_.gridSize <= 0 || config_.sampleCapacity <= 0)
     throw std::logic_error("grid search on a sampler that does not keep what it needs");
   GridSearchResult result = search(
       StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken_ - searched_},
-      costs, rule);
+      costs, rule, pooling);
   searched_ = taken_;
   return result;
 }
 
 void StageSampler::reset() {
   taken_ = searched_ = 0;
+  closed_ = false;
   clearSums();
 }
 
@@ -77,6 +84,15 @@ std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
     if (q < 2) std::fill_n(samples.begin() + record * 16, 16, 0.0f);
   }
   return samples;
+}
+
+bool keepsStatistics(const SamplerConfig& config) { return config.statsMask != 0 || config.sampleCapacity > 0; }
+
+SamplerConfig plainConfig(SamplerConfig config) {
+  config.statsMask = 0;
+  config.sampleCapacity = 0;
+  config.gridSize = 0;
+  return config;
 }
 
 std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize) {
@@ -95,8 +111,11 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
     : StageSampler(scene, config), device_(device), localSize_(localSize) {
   if (localSize < 1) throw InputError("--local-size must be at least 1");
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
-  cl::Program program = buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize));
-  kernel_ = cl::Kernel(program, "sampleStage");
+  kernel_ = cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
+  plainKernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl",
+                                                                   sampleKernelOptions(scene, plainConfig(config), localSize)),
+                                                      "sampleStage")
+                                         : kernel_;
   const EnvmapTables& t = scene.tables;
   texels_ = upload(device, t.texels);
   cdfTable_ = upload(device, t.cdfTable);
@@ -123,6 +142,11 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   empty.counts.assign(size_t(scene.pixelCount()) * empty.techniqueCount, 0);
   empty.firstIndex.assign(empty.counts.size(), 0u);
   run(empty, 0);
+  if (keepsStatistics(config)) {
+    empty.keepStatistics = false;
+    run(empty, 0);
+  }
+  reset();
 }
 
 namespace {
@@ -158,36 +182,35 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   cl::Buffer pixelOrder = upload(device_, coherentPixelOrder(plan, pixels));
   cl::Buffer rgb(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * 3 * accSize);
   cl::Buffer moments(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * M * 2 * accSize);
+  cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
   int a = 0;
-  kernel_.setArg(a++, texels_);
-  kernel_.setArg(a++, cdfTable_);
-  kernel_.setArg(a++, aliasTable_);
-  kernel_.setArg(a++, cl_int(scene_.tables.width));
-  kernel_.setArg(a++, cl_int(scene_.tables.height));
-  kernel_.setArg(a++, brdfParams_);
-  for (float m : scene_.mirror) kernel_.setArg(a++, m);
-  kernel_.setArg(a++, counts);
-  kernel_.setArg(a++, firstIndex);
-  kernel_.setArg(a++, cl_int(plan.stageSamples));
-  kernel_.setArg(a++, cl_uint(seed & 0xffffffffu));
-  kernel_.setArg(a++, cl_uint(seed >> 32));
-  kernel_.setArg(a++, cl_int(pixels));
-  kernel_.setArg(a++, pixelOrder);
-  kernel_.setArg(a++, rgb);
-  kernel_.setArg(a++, moments);
-  kernel_.setArg(a++, stats_);
-  kernel_.setArg(a++, samples_);
-  kernel_.setArg(a++, cl_int(firstSlot));
-  kernel_.setArg(a++, cl_int(config_.sampleCapacity));
+  kernel.setArg(a++, texels_);
+  kernel.setArg(a++, cdfTable_);
+  kernel.setArg(a++, aliasTable_);
+  kernel.setArg(a++, cl_int(scene_.tables.width));
+  kernel.setArg(a++, cl_int(scene_.tables.height));
+  kernel.setArg(a++, brdfParams_);
+  for (float m : scene_.mirror) kernel.setArg(a++, m);
+  kernel.setArg(a++, counts);
+  kernel.setArg(a++, firstIndex);
+  kernel.setArg(a++, cl_int(plan.stageSamples));
+  kernel.setArg(a++, cl_uint(seed & 0xffffffffu));
+  kernel.setArg(a++, cl_uint(seed >> 32));
+  kernel.setArg(a++, cl_int(pixels));
+  kernel.setArg(a++, pixelOrder);
+  kernel.setArg(a++, rgb);
+  kernel.setArg(a++, moments);
+  kernel.setArg(a++, stats_);
+  kernel.setArg(a++, samples_);
+  kernel.setArg(a++, cl_int(firstSlot));
+  kernel.setArg(a++, cl_int(config_.sampleCapacity));
   size_t global = (size_t(pixels) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
-  device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr,
+  device_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr,
                                      &done);
   done.wait();
   StageResult result;
-  result.kernelSeconds =
-      double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-      1e-9;
+  result.kernelSeconds = eventSeconds(done);
   auto read = [&](const cl::Buffer& b, size_t n) {
     return doubleSums_ ? readSums<double>(device_, b, n) : readSums<float>(device_, b, n);
   };
@@ -208,8 +231,9 @@ void Sampler::clearSums() {
   if (gridSearch_) gridSearch_->reset();
 }
 
-GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) {
-  return gridSearch_->run(samples_, layout, costs, rule);
+GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                                 const std::optional<PooledSelection>& pooling) {
+  return gridSearch_->run(samples_, layout, costs, rule, pooling);
 }
 
 std::vector<float> Sampler::storedSamples() {

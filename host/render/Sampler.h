@@ -27,7 +27,9 @@ class StageSampler {
   // 000 Algorithm 1 over every sample taken so far, with the grid of config().gridSize:
   // the searches keep running sums, and each adds the samples of the stages since the
   // one before (kernels/gridsearch.cl on a device, its C++ reference on the host).
-  GridSearchResult searchWeights(const std::vector<double>& costs, GridRule rule);
+  // `pooling`: select by rule (b) over neighbourhoods, with the skip rule.
+  GridSearchResult searchWeights(const std::vector<double>& costs, GridRule rule,
+                                 const std::optional<PooledSelection>& pooling = std::nullopt);
   // Forgets every stage taken so far (running sums, the grid searches' sums), so that
   // the next stage starts a new render on the same compiled kernels.
   void reset();
@@ -43,8 +45,8 @@ class StageSampler {
   // holds sample searched_ + i: the samples before are in the grid searches' sums.
   // Throws std::logic_error if the stage does not fit.
   int takeSlots(const StagePlan& plan);
-  virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs,
-                                  GridRule rule) = 0;
+  virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                                  const std::optional<PooledSelection>& pooling) = 0;
   virtual void clearSums() = 0;
 
   const Scene& scene_;
@@ -53,7 +55,13 @@ class StageSampler {
  private:
   int searched_ = 0;  // samples per pixel that the grid searches have added
   int taken_ = 0;     // samples per pixel taken so far
+  bool closed_ = false;  // a stage without statistics was taken: it must be the last
 };
+
+// Whether a sampler with this config keeps anything beyond the stage estimates, and
+// the config of its stages that keep nothing (StagePlan::keepStatistics false).
+bool keepsStatistics(const SamplerConfig& config);
+SamplerConfig plainConfig(SamplerConfig config);
 
 // The `-D` options that compile kernels/sample.cl for exactly this scene, estimator,
 // statistics and work-group size.
@@ -69,14 +77,15 @@ class Sampler : public StageSampler {
   std::vector<float> storedSamples() override;
 
  private:
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override;
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                          const std::optional<PooledSelection>& pooling) override;
   void clearSums() override;
 
   const Device& device_;
   std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
   int localSize_;
   bool doubleSums_;
-  cl::Kernel kernel_;
+  cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
   cl::Buffer texels_, cdfTable_, aliasTable_, brdfParams_, stats_, samples_;
 };
 
@@ -90,8 +99,9 @@ class HostSampler : public StageSampler {
   std::vector<float> storedSamples() override { return samples_; }
 
  private:
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule) override {
-    return gridSearch_->run(samples_, layout, costs, rule);
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                          const std::optional<PooledSelection>& pooling) override {
+    return gridSearch_->run(samples_, layout, costs, rule, pooling);
   }
   void clearSums() override;
 

@@ -20,6 +20,9 @@ struct StagePlan {
   int samplesBefore = 0;             // samples each pixel took in earlier stages
   std::vector<int32_t> counts;       // [pixel·M + k], Σ_k = N
   std::vector<uint32_t> firstIndex;  // [pixel·M + k]
+  // False for a stage that no allocation follows: it runs the kernel without running
+  // sums or stored samples, as fast as a fixed split's. Only the last stage may.
+  bool keepStatistics = true;
 };
 
 // Per pixel: this stage's unbiased RGB estimate and, per technique, Σ w and Σ w² of
