@@ -230,7 +230,7 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
   for (int lane = 0; lane < lanesUsed; ++lane) {
     PixelSummary before = summaries[16 * block + lane];
     all[lane] = mergeSummaries(before, added[lane]);
-    fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, all[lane]);
+    fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, all[lane], rule);
     scale[lane] = sampleScale(all[lane]);
     rescale[lane] = sumsRescale(before, scale[lane]);
     for (int j = 0; j < MA_TECHNIQUES; ++j) next[lane][j] = preparedFirst(added[lane], j);

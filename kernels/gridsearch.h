@@ -119,20 +119,31 @@ MA_FN size_t runningSumIndex(int pixel, int j, int moment, int l, int techniqueC
   return (((size_t)pixel * techniqueCount + j) * 2 + moment) * paddedSize + l;
 }
 
-// Why a pixel cannot be searched; every reason gives equal weights. A variance
-// estimate needs m_j ≥ 2. A technique whose samples all have f = 0 has μ_j = ν_j = 0:
-// cost × variance would then favour it for free, and eq. 4.16 has no solution with
-// α_j > 0 (Λ_j = c_j V ≥ 0 while Σ_j α_j Λ_j < 0), so the grid cannot be ranked.
-MA_FN ma_uint pixelFallbacks(int techniqueCount, PixelSummary s) {
+// All samples of a pixel so far: the n of rule (b).
+MA_FN float sampleCount(int techniqueCount, PixelSummary s) {
+  float n = 0.0f;
+  for (int k = 0; k < techniqueCount; ++k) n += s.count[k];
+  return n;
+}
+
+// Why a pixel cannot be searched; every reason gives equal weights. Rule (a) estimates
+// each technique's moments from its own samples: that needs m_j ≥ 2, and a technique
+// whose samples all have f = 0 has μ_j = ν_j = 0, which eq. 4.16 cannot rank (Λ_j =
+// c_j V ≥ 0 while Σ_j α_j Λ_j < 0). Rule (b) estimates V from all n samples at once
+// (costVarianceScore): it needs n ≥ 2 and some f > 0, and a silent technique only
+// tells it that α_j buys little.
+MA_FN ma_uint pixelFallbacks(int techniqueCount, PixelSummary s, int rule) {
   if (s.invalid) return MA_FALLBACK_NON_FINITE;
   ma_uint bits = 0;
   int signal = 0;
   for (int j = 0; j < techniqueCount; ++j) {
-    bits |= s.count[j] < 2.0f ? MA_FALLBACK_TOO_FEW_SAMPLES : 0u;
+    bits |= rule == MA_RULE_MAX_ENTROPY && s.count[j] < 2.0f ? MA_FALLBACK_TOO_FEW_SAMPLES : 0u;
     signal |= s.nonZero[j] > 0;
   }
+  if (rule != MA_RULE_MAX_ENTROPY && sampleCount(techniqueCount, s) < 2.0f) bits |= MA_FALLBACK_TOO_FEW_SAMPLES;
   if (bits != 0) return bits;
   if (!signal) return MA_FALLBACK_NO_SIGNAL;
+  if (rule != MA_RULE_MAX_ENTROPY) return 0u;
   for (int j = 0; j < techniqueCount; ++j) bits |= s.nonZero[j] > 0 ? 0u : MA_FALLBACK_SILENT_TECHNIQUE;
   return bits;
 }
@@ -232,13 +243,6 @@ MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix)
   float m = 0.0f;
   for (int k = 0; k < techniqueCount; ++k) m += added.count[k];
   for (int k = 0; k < techniqueCount; ++k) stageMix[k] = m > 0.0f ? added.count[k] / m : 0.0f;
-}
-
-// All samples of a pixel so far: the n of rule (b).
-MA_FN float sampleCount(int techniqueCount, PixelSummary s) {
-  float n = 0.0f;
-  for (int k = 0; k < techniqueCount; ++k) n += s.count[k];
-  return n;
 }
 
 // Rule (a), 000 Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance

@@ -303,7 +303,7 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
   kern::PixelSummary added = kern::emptySummary();
   for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&added, pixelSamples, m, i);
   const kern::PixelSummary all = kern::mergeSummaries(summary, added);
-  unsigned fallbacks = kern::pixelFallbacks(m, all);
+  unsigned fallbacks = kern::pixelFallbacks(m, all, setup.rule);
   int best = -1;
   scale = kern::sampleScale(all);
   // Pixels that cannot be ranked yet keep their sums for the searches to come.
