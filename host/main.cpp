@@ -13,6 +13,7 @@
 #include "AtomicFile.h"
 #include "Error.h"
 #include "JsonText.h"
+#include "MemoryBudget.h"
 #include "NumberList.h"
 #include "OptionRange.h"
 #include "OutputSet.h"
@@ -60,6 +61,9 @@ struct SceneArgs {
   // The options with --size, --view and --envmap-sampler parsed; throws InputError.
   SceneOptions parsed() {
     std::tie(options.width, options.height) = parseImageSize(size);
+    const double pixels = double(options.width) * options.height;
+    requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
+                      pixels * kRenderBytesPerPixel);
     std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");
     if (angles.size() > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
     options.viewTheta = angles[0];
@@ -86,6 +90,7 @@ struct SceneArgs {
 struct AdaptiveArgs {
   AdaptiveOptions options;
   std::string costList, linearRule = "variance", gridRule = "variance";
+  CLI::Option* costOption = nullptr;  // given, even as "", or not
 
   void add(CLI::App* app) {
     app->add_option("--pilot", options.pilotFraction, "adaptive methods: the pilot's share of the budget")
@@ -94,7 +99,7 @@ struct AdaptiveArgs {
     app->add_option("--stages", options.stages, "adaptive methods: stages after the pilot")
         ->capture_default_str()
         ->check(integerIn(1, INT_MAX));
-    app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
+    costOption = app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
     app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
         ->capture_default_str();
     app->add_option("--grid-u", options.gridSize, "exact, oracle: number U of weight combinations searched")
@@ -135,7 +140,7 @@ AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
   AdaptiveOptions o = options;
   o.linearRule = parseLinearRule(linearRule);
   o.gridRule = parseGridRule(gridRule);
-  if (!costList.empty()) o.costs = parseCosts(costList, techniqueCount);
+  if (costOption->count() > 0) o.costs = parseCosts(costList, techniqueCount);
   return o;
 }
 
@@ -171,6 +176,37 @@ std::vector<NamedFile> envmapInputs(const std::vector<SceneOptions>& scenes) {
     if (std::filesystem::exists(file)) inputs.push_back({"--envmap", file});
   }
   return inputs;
+}
+
+// The host memory of the samples a method stores and, on the C++ device, of the grid
+// search's sums, refused up front with the option that asks for it.
+void requireStatisticsMemory(const Scene& scene, Method m, int spp, const AdaptiveOptions& adaptive,
+                             const SamplerConfig& config, const std::string& deviceSpec) {
+  const double pixels = scene.pixelCount(), M = scene.techniqueCount();
+  if (config.sampleCapacity > 0) {
+    // A record of M + 2 floats per sample, on a CPU device once in its buffer and once
+    // read back (kernels/stats.h).
+    const double perPixel = double(config.sampleCapacity) * (M + 2) * sizeof(float) * 2;
+    std::string option = m == Method::Oracle ? fmt::format("--spp {} and --oracle-spp {}", spp, adaptive.oracleSamples)
+                                             : fmt::format("--spp {}", spp);
+    requireHostMemory(fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
+                                  methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * 2),
+                      pixels * perPixel);
+  }
+  if (config.gridSize > 0) {
+    // The weight grid, M weights and a cost per combination, is built on the host; the
+    // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
+    // (alloc/GridSearch.h). Both from the options alone: building the grid to size it
+    // would be the allocation this check prevents.
+    const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
+    const double sumBytes = deviceSpec == "host" ? pixels * 2 * M * U * sizeof(float) : 0;
+    requireHostMemory(fmt::format("--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U,
+                                  (M + 1) * sizeof(float),
+                                  sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels,
+                                                             2 * M * U * sizeof(float))
+                                               : ""),
+                      gridBytes + sumBytes);
+  }
 }
 
 // CLI11 takes a word it does not know for a stray argument; say what it is instead.
@@ -307,6 +343,7 @@ int main(int argc, char** argv) {
             fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
       std::unique_ptr<Device> device;
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
+      requireStatisticsMemory(scene, m, spp, adaptive, config, deviceSpec);
       auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);
       std::string deviceName = samplerDeviceName(device);
       // Without statistics: for the reference and for measuring costs.
@@ -394,9 +431,9 @@ int main(int argc, char** argv) {
                                reference->path.empty() ? "" : " at " + reference->path);
     }
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; every parse error is bad input.
-    int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::cerr << "misalloc: error: " << e.what() << "\nRun with --help for more information.\n";
+    return 2;  // CLI11's own codes (104–114) would each mean "bad input" too
   } catch (const InputError& e) {
     std::cerr << "misalloc: error: " << e.what() << "\n";
     return 2;

@@ -18,6 +18,7 @@
 
 #include "AtomicFile.h"
 #include "Error.h"
+#include "MemoryBudget.h"
 
 namespace misalloc {
 namespace {
@@ -66,6 +67,8 @@ RgbImage readRgbPixels(const std::string& path) {
   RgbImage image;
   image.width = window.max.x - window.min.x + 1;
   image.height = window.max.y - window.min.y + 1;
+  requireHostMemory(fmt::format("'{}' ({}×{} texels × 12 B)", path, image.width, image.height),
+                    double(image.width) * image.height * 3 * sizeof(float));
   image.rgb.resize(std::size_t(image.width) * std::size_t(image.height) * 3);
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
