@@ -11,16 +11,9 @@ namespace misalloc {
 // the counts, first indices, moments and α (about 200 B for M = 3), rounded up.
 constexpr uint64_t kRenderBytesPerPixel = 256;
 
-// This machine's physical memory in bytes.
-uint64_t physicalMemoryBytes();
-
-// "1.5 GiB"
-std::string gibibytes(double bytes);
-
-// Throws InputError unless `bytes` (a double: products of options cannot overflow it)
-// fit in physical memory. `what` names the option
-// and its value and says how the figure arises, e.g. "--size 40000x40000 (1.6e9
-// pixels × 256 B)".
+// Throws InputError unless `bytes` fit in this machine's physical memory. `what` names
+// the option and its value and says how the figure arises, e.g. "--size 40000x40000
+// (1.6e9 pixels × 256 B)". A double, so that products of options cannot overflow.
 void requireHostMemory(const std::string& what, double bytes);
 
 }  // namespace misalloc

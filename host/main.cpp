@@ -10,7 +10,6 @@
 #include <memory>
 #include <sstream>
 
-#include "AtomicFile.h"
 #include "Error.h"
 #include "JsonText.h"
 #include "MemoryBudget.h"
@@ -102,9 +101,10 @@ struct AdaptiveArgs {
     costOption = app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
     app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
         ->capture_default_str();
+    // α is a float: beyond 2^24 combinations, neighbouring weights would coincide.
     app->add_option("--grid-u", options.gridSize, "exact, oracle: number U of weight combinations searched")
         ->capture_default_str()
-        ->check(integerIn(2, INT_MAX));
+        ->check(integerIn(2, 1 << 24));
     app->add_option("--grid-rule", gridRule,
                     "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
         ->capture_default_str();
@@ -179,16 +179,18 @@ std::vector<NamedFile> envmapInputs(const std::vector<SceneOptions>& scenes) {
 }
 
 // The host memory of the samples a method stores and, on the C++ device, of the grid
-// search's sums, refused up front with the option that asks for it.
-void requireStatisticsMemory(const Scene& scene, Method m, int spp, const AdaptiveOptions& adaptive,
-                             const SamplerConfig& config, const std::string& deviceSpec) {
-  const double pixels = scene.pixelCount(), M = scene.techniqueCount();
+// search's sums, refused up front with the option that asks for it: `sppOption` is
+// --spp for render, --budgets for compare.
+void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::string& sppOption, int spp,
+                             const AdaptiveOptions& adaptive, const std::string& deviceSpec) {
+  const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
+  const double pixels = double(scene.width) * scene.height, M = scene.splitBrdf ? 3 : 2;
   if (config.sampleCapacity > 0) {
     // A record of M + 2 floats per sample, on a CPU device once in its buffer and once
     // read back (kernels/stats.h).
     const double perPixel = double(config.sampleCapacity) * (M + 2) * sizeof(float) * 2;
-    std::string option = m == Method::Oracle ? fmt::format("--spp {} and --oracle-spp {}", spp, adaptive.oracleSamples)
-                                             : fmt::format("--spp {}", spp);
+    std::string option = fmt::format("{} {}", sppOption, spp);
+    if (m == Method::Oracle) option += fmt::format(" and --oracle-spp {}", adaptive.oracleSamples);
     requireHostMemory(fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
                                   methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * 2),
                       pixels * perPixel);
@@ -343,7 +345,7 @@ int main(int argc, char** argv) {
             fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
       std::unique_ptr<Device> device;
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
-      requireStatisticsMemory(scene, m, spp, adaptive, config, deviceSpec);
+      requireStatisticsMemory(scene.options, m, "--spp", spp, adaptive, deviceSpec);
       auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);
       std::string deviceName = samplerDeviceName(device);
       // Without statistics: for the reference and for measuring costs.
@@ -401,6 +403,10 @@ int main(int argc, char** argv) {
       compare.budgets = parseBudgets(budgetList);
       compare.adaptive = compareAdaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
       validateCompareOptions(compare);
+      for (const CompareCase& c : compare.cases)
+        for (Method m : compare.methods)
+          for (int budget : compare.budgets)
+            requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, compare.device);
       std::vector<SceneOptions> scenes;
       for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
       OutputSet outputs(envmapInputs(scenes));

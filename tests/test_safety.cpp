@@ -266,6 +266,12 @@ TEST_CASE("exit codes: 2 for bad input, 3 for OpenCL errors, 0 for help", "[cli]
       {w.render("--cache-dir /proc/no/cache --reference auto"), 2, "--cache-dir /proc/no/cache"},
       {fmt::format("compare --envmap constant --size 4x4 --methods equal --budgets 4 --out-dir /proc/no/out {}", cache), 2,
        "--out-dir /proc/no/out"},
+      {w.render("--method linear --size 64x64 --spp 1000000000"), 2, "--spp 1000000000 with --method linear"},
+      {fmt::format("compare --envmap constant --size 64x64 --methods linear --budgets 100,1000000 --out-dir {} {}",
+                   w.path("cmp"), cache),
+       2, "--budgets 1000000 with --method linear"},
+      {w.render("--method oracle --size 64x64 --spp 40 --oracle-spp 1000000000"), 2, "--oracle-spp 1000000000"},
+      {w.render("--method exact --grid-u 16777217"), 2, "--grid-u"},
       {w.render("--local-size 100000"), 3, "--local-size 100000"},
       {w.render("--method exact --grid-u 1000000 --size 64x64 --spp 40"), 3, "--grid-u 1000000"},
   };
@@ -275,6 +281,7 @@ TEST_CASE("exit codes: 2 for bad input, 3 for OpenCL errors, 0 for help", "[cli]
     CHECK(r.exitCode == c.code);
     CHECK(r.output.find(c.expected) != std::string::npos);
   }
+  CHECK_FALSE(fs::exists(w.path("cmp")));
 }
 
 namespace {
@@ -326,7 +333,7 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
   const std::vector<NumericOption> adaptive = {
       {"--pilot", withNotNumbers({"0", "1", "-0.1", "1.5", "1e309"})},
       count("--stages", 1),
-      count("--grid-u", 2),
+      count("--grid-u", 2, "16777217"),
       count("--oracle-spp", 2),
       {"--cost", {"1,nan", "1,inf", "1,0", "1,-1", "1", "1,2,3", "1,,2", "''", "junk,1", "1e309,1"}},
   };
