@@ -2,8 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <sstream>
 
 #include "Error.h"
 
@@ -12,17 +13,15 @@ namespace misalloc {
 std::vector<double> parseNumberList(const std::string& option, const std::string& value, const std::string& list,
                                     size_t expected, const std::string& forms) {
   std::vector<double> numbers;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    size_t used = 0;
+  // Split by hand: getline would drop an empty last item ("1,2,").
+  for (size_t start = 0; !list.empty() && start <= list.size();) {
+    size_t end = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, end - start);
+    start = end + 1;
+    // from_chars, unlike stod, takes no leading space, hex or sign and never throws.
     double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(v))
+    auto [stop, error] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (item.empty() || error != std::errc() || stop != item.data() + item.size() || !std::isfinite(v))
       throw InputError(fmt::format("{} {}: '{}' is not a number ({})", option, value, item, forms));
     numbers.push_back(v);
   }

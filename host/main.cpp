@@ -3,14 +3,19 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
-#include "AtomicFile.h"
 #include "Error.h"
+#include "JsonText.h"
+#include "MemoryBudget.h"
 #include "NumberList.h"
+#include "OptionRange.h"
+#include "OutputSet.h"
 #include "cl/Device.h"
 #include "compare/CompareReport.h"
 #include "compare/Comparison.h"
@@ -48,22 +53,26 @@ struct SceneArgs {
                   "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
     app->add_option("--envmap-sampler", sampler, "alias (O(1)) or cdf (two binary searches)")->capture_default_str();
     app->add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(integerIn(2, 16384));
+  }
+
+  // The options with --size, --view and --envmap-sampler parsed; throws InputError.
+  SceneOptions parsed() {
+    std::tie(options.width, options.height) = parseImageSize(size);
+    const double pixels = double(options.width) * options.height;
+    requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
+                      pixels * kRenderBytesPerPixel);
+    std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");
+    if (angles.size() > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
+    options.viewTheta = angles[0];
+    options.viewPhi = angles.size() > 1 ? angles[1] : 0;
+    options.sampler = parseEnvmapSampler(sampler);
+    return options;
   }
 
   Scene make() {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w <= 0 || h <= 0)
-      throw InputError(fmt::format("--size {}: expected WxH with W, H ≥ 1", size));
-    options.width = w;
-    options.height = h;
-    double theta = 0, phi = 0;
-    int n = std::sscanf(view.c_str(), "%lf,%lf%c", &theta, &phi, &extra);
-    if (n < 1 || n > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
-    options.viewTheta = theta;
-    options.viewPhi = phi;
-    options.sampler = parseEnvmapSampler(sampler);
+    parsed();
     Scene scene = makeScene(options);
     const ReadWarnings& repaired = scene.envmapWarnings;
     if (repaired.negativeValues > 0)
@@ -80,26 +89,36 @@ struct SceneArgs {
 struct AdaptiveArgs {
   AdaptiveOptions options;
   std::string costList, linearRule = "variance", gridRule = "variance";
+  CLI::Option* costOption = nullptr;  // given, even as "", or not
 
   void add(CLI::App* app) {
     app->add_option("--pilot", options.pilotFraction, "adaptive methods: the pilot's share of the budget")
-        ->capture_default_str();
-    app->add_option("--stages", options.stages, "adaptive methods: stages after the pilot")->capture_default_str();
+        ->capture_default_str()
+        ->check(realIn(0, 1, true, true));
+    app->add_option("--stages", options.stages, "adaptive methods: stages after the pilot")
+        ->capture_default_str()
+        ->check(integerIn(1, INT_MAX));
     app->add_option("--pool", options.poolRadius,
                     "adaptive methods: allocate from the statistics of the (2R+1)^2 pixels around each pixel")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(integerIn(0, 1 << 12));
     app->add_option("--skip-below", options.minGain,
                     "exact: keep equal counts where the predicted gain of adapting is below this fraction")
-        ->capture_default_str();
-    app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
+        ->capture_default_str()
+        ->check(realIn(0, 1, false, true));
+    costOption = app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
     app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
         ->capture_default_str();
+    // α is a float: beyond 2^24 combinations, neighbouring weights would coincide.
     app->add_option("--grid-u", options.gridSize, "exact, oracle: number U of weight combinations searched")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(integerIn(2, 1 << 24));
     app->add_option("--grid-rule", gridRule,
                     "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
         ->capture_default_str();
-    app->add_option("--oracle-spp", options.oracleSamples, "oracle: probe samples per pixel")->capture_default_str();
+    app->add_option("--oracle-spp", options.oracleSamples, "oracle: probe samples per pixel")
+        ->capture_default_str()
+        ->check(integerIn(2, INT_MAX));
   }
 
   // The options with the rules parsed and the costs, when given, checked for M
@@ -129,9 +148,7 @@ AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
   AdaptiveOptions o = options;
   o.linearRule = parseLinearRule(linearRule);
   o.gridRule = parseGridRule(gridRule);
-  if (o.gridSize < 2)
-    throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", o.gridSize));
-  if (!costList.empty()) o.costs = parseCosts(costList, techniqueCount);
+  if (costOption->count() > 0) o.costs = parseCosts(costList, techniqueCount);
   return o;
 }
 
@@ -159,6 +176,58 @@ std::vector<int> parseBudgets(const std::string& list) {
   return budgets;
 }
 
+// The envmap files that the scenes read: no output may replace one.
+std::vector<NamedFile> envmapInputs(const std::vector<SceneOptions>& scenes) {
+  std::vector<NamedFile> inputs;
+  for (const SceneOptions& o : scenes) {
+    std::string file = resolveEnvmapSpec(o.envmap);
+    if (std::filesystem::exists(file)) inputs.push_back({"--envmap", file});
+  }
+  return inputs;
+}
+
+// The host memory of the samples a method stores and, on the C++ device, of the grid
+// search's sums, refused up front with the option that asks for it: `sppOption` is
+// --spp for render, --budgets for compare.
+void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::string& sppOption, int spp,
+                             const AdaptiveOptions& adaptive, const std::string& deviceSpec) {
+  const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
+  const double pixels = double(scene.width) * scene.height, M = scene.splitBrdf ? 3 : 2;
+  if (config.sampleCapacity > 0) {
+    // A record of M + 2 floats per sample, on a CPU device once in its buffer and once
+    // read back (kernels/stats.h).
+    const double perPixel = double(config.sampleCapacity) * (M + 2) * sizeof(float) * 2;
+    std::string option = fmt::format("{} {}", sppOption, spp);
+    if (m == Method::Oracle) option += fmt::format(" and --oracle-spp {}", adaptive.oracleSamples);
+    requireHostMemory(fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
+                                  methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * 2),
+                      pixels * perPixel);
+  }
+  if (config.gridSize > 0) {
+    // The weight grid, M weights and a cost per combination, is built on the host; the
+    // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
+    // (alloc/GridSearch.h). Both from the options alone: building the grid to size it
+    // would be the allocation this check prevents.
+    const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
+    const double sumBytes = deviceSpec == "host" ? pixels * 2 * M * U * sizeof(float) : 0;
+    requireHostMemory(fmt::format("--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U,
+                                  (M + 1) * sizeof(float),
+                                  sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels,
+                                                             2 * M * U * sizeof(float))
+                                               : ""),
+                      gridBytes + sumBytes);
+  }
+}
+
+// CLI11 takes a word it does not know for a stray argument; say what it is instead.
+void refuseUnknownSubcommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return;
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+  if (std::find(names.begin(), names.end(), argv[1]) == names.end())
+    throw InputError(fmt::format("unknown subcommand '{}'; the subcommands are {}", argv[1], fmt::join(names, ", ")));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -176,7 +245,7 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   std::string method = "equal", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
               reportPath = "render.json", referenceMode = "auto", cacheDir = defaultCacheDir();
-  renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str();
+  renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
   renderCmd->add_option("--method", method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
       ->capture_default_str();
   AdaptiveArgs renderAdaptive;
@@ -185,7 +254,7 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--alpha-map", alphaMap, "write the per-pixel allocation: EXR here, false-colour PNG beside");
   renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi (000 eq. 4.1) or one (one-sample MIS)")
       ->capture_default_str();
-  renderCmd->add_option("--seed", seed, "random seed")->capture_default_str();
+  renderCmd->add_option("--seed", seed, "random seed")->capture_default_str()->check(anyUnsigned64());
   renderCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, an index from `misalloc devices`, or host (C++)")
       ->capture_default_str();
   renderCmd->add_option("--out", out, "output EXR")->capture_default_str();
@@ -194,15 +263,19 @@ int main(int argc, char** argv) {
       ->add_option("--reference", referenceMode,
                    "auto (analytic, cached, or computed and cached), none, or an EXR path")
       ->capture_default_str();
-  renderCmd->add_option("--reference-spp", referenceSpp, "spp of a sampled reference")->capture_default_str();
+  renderCmd->add_option("--reference-spp", referenceSpp, "spp of a sampled reference")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
   renderCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
-  renderCmd->add_option("--local-size", localSize, "OpenCL work-group size")->capture_default_str();
+  renderCmd->add_option("--local-size", localSize, "OpenCL work-group size")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
 
   auto* referenceCmd = app.add_subcommand("reference", "compute (or find in the cache) a converged reference image");
   SceneArgs referenceScene;
   referenceScene.add(referenceCmd);
   std::string referenceOut;
-  referenceCmd->add_option("--spp", referenceSpp, "samples per pixel")->capture_default_str();
+  referenceCmd->add_option("--spp", referenceSpp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
   referenceCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, index or host")->capture_default_str();
   referenceCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
   referenceCmd->add_option("--out", referenceOut, "also write the reference to this EXR");
@@ -221,14 +294,20 @@ int main(int argc, char** argv) {
   compareCmd->add_option("--methods", methodList, "comma-separated methods, or all")->capture_default_str();
   compareCmd->add_option("--budgets", budgetList, "samples per pixel, ascending")->capture_default_str();
   compareCmd->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
-      ->capture_default_str();
-  compareCmd->add_option("--seed", compare.seed, "repeat r uses seed + r")->capture_default_str();
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  compareCmd->add_option("--seed", compare.seed, "repeat r uses seed + r")->capture_default_str()->check(anyUnsigned64());
   compareCmd->add_option("--table-spp", compare.tableBudget, "the budget of the Table 5.2 layout (nearest one run)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
   compareCmd->add_option("--out-dir", compare.outDir, "output folder (created if missing)")->required();
   compareCmd->add_option("--device", compare.device, "auto, cpu, gpu, an index, or host (C++)")->capture_default_str();
-  compareCmd->add_option("--local-size", compare.localSize, "OpenCL work-group size")->capture_default_str();
-  compareCmd->add_option("--reference-spp", compare.referenceSpp, "spp of a sampled reference")->capture_default_str();
+  compareCmd->add_option("--local-size", compare.localSize, "OpenCL work-group size")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  compareCmd->add_option("--reference-spp", compare.referenceSpp, "spp of a sampled reference")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
   compare.cacheDir = defaultCacheDir();
   compareCmd->add_option("--cache-dir", compare.cacheDir, "where references are cached")->capture_default_str();
 
@@ -237,30 +316,32 @@ int main(int argc, char** argv) {
   paperCmd->add_option("id", paperId, "example id (see `misalloc paper`)");
 
   try {
+    refuseUnknownSubcommand(app, argc, argv);
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-
-  try {
     if (app.got_subcommand("devices")) {
       listDevices(std::cout);
     } else if (app.got_subcommand("paper")) {
-      if (paperId.empty())
+      if (paperId.empty()) {
         listPaperExamples(std::cout);
-      else
+      } else {
+        const std::vector<std::string> ids = paperExampleIds();
+        if (std::find(ids.begin(), ids.end(), paperId) == ids.end())
+          throw InputError(fmt::format("paper {}: unknown example; valid ids: {}", paperId, fmt::join(ids, ", ")));
         printPaperExample(paperId, std::cout);
+      }
     } else if (app.got_subcommand("render")) {
-      if (spp < 1) throw InputError(fmt::format("--spp {}: need at least 1 sample per pixel", spp));
       Method m = parseMethod(method);
       Estimator estimator = parseEstimator(estimatorName);
       if (isAdaptive(m) && estimator != Estimator::MultiSample)
         throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", estimatorName));
-      checkWritableOutput(out, "--out");
-      checkWritableOutput(reportPath, "--report");
+      std::vector<NamedFile> inputs = envmapInputs({renderScene.parsed()});
+      if (referenceMode != "auto" && referenceMode != "none") inputs.push_back({"--reference", referenceMode});
+      OutputSet outputs(inputs);
+      outputs.claim("--out", out);
+      outputs.claim("--report", reportPath);
       if (!alphaMap.empty()) {
-        checkWritableOutput(alphaMap, "--alpha-map");
-        checkWritableOutput(alphaPngPath(alphaMap), "--alpha-map");
+        outputs.claim("--alpha-map", alphaMap);
+        outputs.claim("--alpha-map", alphaPngPath(alphaMap));
       }
       Scene scene = renderScene.make();
       AdaptiveOptions adaptive = renderAdaptive.make(scene.techniqueCount());
@@ -272,6 +353,7 @@ int main(int argc, char** argv) {
             fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
       std::unique_ptr<Device> device;
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
+      requireStatisticsMemory(scene.options, m, "--spp", spp, adaptive, deviceSpec);
       auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);
       std::string deviceName = samplerDeviceName(device);
       // Without statistics: for the reference and for measuring costs.
@@ -290,9 +372,14 @@ int main(int argc, char** argv) {
       Rendering r = render(*sampler, m, adaptive, spp, seed);
       nlohmann::json report =
           renderReport({scene, m, config.estimator, adaptive, costSource, spp, seed, deviceName, r, reference});
-      writeExr(out, r.image);
-      if (!alphaMap.empty()) writeAlphaMaps(alphaMap, scene, r);
-      writeFileAtomically(reportPath, report.dump(2) + "\n");
+      outputs.put(out, encodeExr(r.image));
+      if (!alphaMap.empty()) {
+        AlphaMapFiles alpha = encodeAlphaMaps(scene, r);
+        outputs.put(alphaMap, std::move(alpha.exr));
+        outputs.put(alphaPngPath(alphaMap), std::move(alpha.png));
+      }
+      outputs.put(reportPath, jsonText(report));
+      outputs.commit();
       std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s, allocation {:.3f} s)\n",
                                deviceName, scene.options.envmap, scene.options.grid, scene.grid.width,
                                scene.grid.height, spp, methodName(m), r.wallSeconds, r.kernelSeconds,
@@ -324,30 +411,52 @@ int main(int argc, char** argv) {
       compare.budgets = parseBudgets(budgetList);
       compare.adaptive = compareAdaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
       validateCompareOptions(compare);
+      for (const CompareCase& c : compare.cases)
+        for (Method m : compare.methods)
+          for (int budget : compare.budgets)
+            requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, compare.device);
+      std::vector<SceneOptions> scenes;
+      for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
+      OutputSet outputs(envmapInputs(scenes));
+      const std::string outDir = compare.outDir;
+      compare.outDir = outputs.claimFolder("--out-dir", outDir);  // filled as it runs, moved in at the end
       Comparison comparison = runComparison(compare, guard);
       Summary summary = summarize(comparison, compare);
       writeCompareReport(summary, compare.outDir);
+      outputs.commit();
       if (comparison.interrupted) {
         std::cerr << fmt::format("misalloc: interrupted after {} runs; {} holds them, every file complete\n",
-                                 comparison.runs.size(), compare.outDir);
+                                 comparison.runs.size(), outDir);
         return 130;
       }
       std::cout << summaryMarkdown(summary);
       std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n",
-                               compare.outDir);
+                               outDir);
     } else if (app.got_subcommand("reference")) {
-      if (referenceSpp < 1) throw InputError("--spp must be at least 1");
-      if (!referenceOut.empty()) checkWritableOutput(referenceOut, "--out");
+      OutputSet outputs(envmapInputs({referenceScene.parsed()}));
+      if (!referenceOut.empty()) outputs.claim("--out", referenceOut);
       Scene scene = referenceScene.make();
       std::unique_ptr<Device> device;
       auto sampler = makeStageSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
       auto reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
-      if (!referenceOut.empty()) writeExr(referenceOut, reference->image);
+      if (!referenceOut.empty()) outputs.put(referenceOut, encodeExr(reference->image));
+      outputs.commit();
       std::cout << fmt::format("reference: {}{}\n", reference->source,
                                reference->path.empty() ? "" : " at " + reference->path);
     }
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::cerr << "misalloc: error: " << e.what() << "\nRun with --help for more information.\n";
+    return 2;  // CLI11's own codes (104–114) would each mean "bad input" too
   } catch (const InputError& e) {
     std::cerr << "misalloc: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::cerr << "misalloc: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "misalloc: error: out of memory: --size, --spp and --grid-u of the adaptive methods, and the "
+                 "envmap's texels decide how much a run needs\n";
     return 2;
   } catch (const DeviceError& e) {
     std::cerr << "misalloc: OpenCL error: " << e.what() << "\n";
@@ -356,7 +465,7 @@ int main(int argc, char** argv) {
     std::cerr << "misalloc: OpenCL error: " << e.what() << " (code " << e.err() << ")\n";
     return 3;
   } catch (const std::exception& e) {
-    std::cerr << "misalloc: error: " << e.what() << "\n";
+    std::cerr << "misalloc: internal error: " << e.what() << "\n";
     return 1;
   }
   return 0;

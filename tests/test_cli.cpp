@@ -15,6 +15,7 @@
 
 #include "Error.h"
 #include "CliRunner.h"
+#include "RawExr.h"
 #include "TestDevice.h"
 #include "cl/Device.h"
 #include "scene/ExrIO.h"
@@ -53,16 +54,16 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
   const Case cases[] = {
       {"--envmap /no/such/file.exr", "/no/such/file.exr"},
       {"--envmap no_such_map", "no_such_map"},
-      {"--spp 0", "--spp 0"},
+      {"--spp 0", "--spp: '0'"},
       {"--size 0x0", "--size 0x0"},
       {"--size 12", "--size 12"},
       {"--method magic", "unknown --method 'magic'"},
-      {"--method exact --spp 40 --grid-u 1", "--grid-u 1"},
+      {"--method exact --spp 40 --grid-u 1", "--grid-u: '1'"},
       {"--method exact --spp 40 --grid-rule best", "--grid-rule 'best'"},
       {"--method heuristic --spp 5", "smaller than the pilot"},
       {"--method heuristic --spp 40 --cost 1,0", "costs must be positive"},
       {"--method heuristic --spp 40 --cost 1", "expected 2 numbers"},
-      {"--method heuristic --pilot 1.5", "--pilot 1.5"},
+      {"--method heuristic --pilot 1.5", "--pilot: '1.5'"},
       {"--method heuristic --estimator one", "multi-sample stages"},
       {"--grid marble", "unknown --grid 'marble'"},
       {"--grid uniform:0.8,0.8,10", "ρd + ρs ≤ 1"},
@@ -108,7 +109,7 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
   }
   misalloc::RgbImage nan{4, 2, std::vector<float>(24, 1.0f)};
   nan.rgb[3 * (1 * 4 + 2) + 0] = std::numeric_limits<float>::quiet_NaN();  // x=2, y=1, R
-  misalloc::writeExr(file("nan.exr"), nan);
+  misalloc::test::writeRawExr(file("nan.exr"), nan);
   struct Case {
     std::string name, expected;
   };

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "Error.h"
+#include "RawExr.h"
 #include "scene/ExrIO.h"
 
 namespace fs = std::filesystem;
@@ -199,7 +200,7 @@ TEST_CASE("readExr rejects bad files with an InputError naming the file and the 
     RgbImage image = testImage(5, 4);
     image.rgb[3 * (1 * 5 + 2) + 1] = std::numeric_limits<float>::quiet_NaN();  // x=2, y=1, G
     image.rgb[3 * (3 * 5 + 0) + 2] = -std::numeric_limits<float>::infinity();
-    misalloc::writeExr(dir / "nan.exr", image);
+    misalloc::test::writeRawExr(dir / "nan.exr", image);
     requireError(dir / "nan.exr", "2 NaN or infinite channel values, the first at x=2, y=1, channel G");
   }
 }

@@ -1,6 +1,7 @@
 #include "compare/CompareReport.h"
 
 #include "AtomicFile.h"
+#include "JsonText.h"
 #include "compare/ErrorTimePlot.h"
 #include "compare/HtmlIndex.h"
 #include "compare/SummaryTables.h"
@@ -10,7 +11,7 @@ namespace misalloc {
 void writeCompareReport(const Summary& summary, const std::string& outDir) {
   writeFileAtomically(outDir + "/summary.md", summaryMarkdown(summary));
   writeFileAtomically(outDir + "/summary.csv", summaryCsv(summary));
-  writeFileAtomically(outDir + "/summary.json", summaryJson(summary).dump(2) + "\n");
+  writeFileAtomically(outDir + "/summary.json", jsonText(summaryJson(summary)));
   writeFileAtomically(outDir + "/budgets.csv", budgetsCsv(summary));
   for (const CaseSummary& c : summary.cases)
     writeFileAtomically(outDir + "/" + plotFileName(c.info.label), errorTimePlotSvg(c));

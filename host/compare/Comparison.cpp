@@ -7,6 +7,7 @@
 
 #include "AtomicFile.h"
 #include "Error.h"
+#include "JsonText.h"
 #include "compare/ProgressMeter.h"
 #include "render/AlphaMap.h"
 #include "render/Costs.h"
@@ -96,7 +97,7 @@ void writeRuns(const std::string& outDir, const Comparison& comparison) {
       {"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
   for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseJson(c));
   for (const RunRecord& r : comparison.runs) json["runs"].push_back(runJson(r));
-  writeFileAtomically(outDir + "/runs.json", json.dump(2) + "\n");
+  writeFileAtomically(outDir + "/runs.json", jsonText(json));
   writeFileAtomically(outDir + "/runs.csv", runsCsv(comparison));
 }
 

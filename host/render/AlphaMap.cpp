@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "AtomicFile.h"
 #include "scene/PngIO.h"
 
 namespace misalloc {
@@ -12,7 +13,7 @@ std::string alphaPngPath(const std::string& exrPath) {
   return (hasExt ? exrPath.substr(0, exrPath.size() - ext.size()) : exrPath) + ".png";
 }
 
-void writeAlphaMaps(const std::string& path, const Scene& scene, const Rendering& rendering) {
+AlphaMapFiles encodeAlphaMaps(const Scene& scene, const Rendering& rendering) {
   const int W = scene.grid.width, H = scene.grid.height, M = scene.techniqueCount();
   std::vector<std::string> names;
   for (const auto& t : scene.techniqueNames()) names.push_back("alpha." + t);
@@ -24,8 +25,13 @@ void writeAlphaMaps(const std::string& path, const Scene& scene, const Rendering
     rgb[3 * p + 0] = uint8_t(std::lround(255 * (1 - envmap)));
     rgb[3 * p + 2] = uint8_t(std::lround(255 * envmap));
   }
-  writeExrChannels(path, W, H, names, planes);
-  writePng(alphaPngPath(path), W, H, rgb);
+  return {encodeExrChannels(W, H, names, planes), encodePng(W, H, rgb)};
+}
+
+void writeAlphaMaps(const std::string& path, const Scene& scene, const Rendering& rendering) {
+  AlphaMapFiles files = encodeAlphaMaps(scene, rendering);
+  writeFileAtomically(path, files.exr);
+  writeFileAtomically(alphaPngPath(path), files.png);
 }
 
 }  // namespace misalloc

@@ -5,9 +5,15 @@
 
 namespace misalloc {
 
-// Writes the per-pixel allocation: `path` (EXR) holds one channel alpha.<technique> per
-// technique; `path` with .png for .exr a false-colour picture as in 000 Fig. 5.5:
-// blue = envmap sampling only, red = BRDF sampling only (both lobes when split).
+// The per-pixel allocation as two files: an EXR with one channel alpha.<technique>
+// per technique, and a false-colour PNG as in 000 Fig. 5.5: blue = envmap sampling
+// only, red = BRDF sampling only (both lobes when split).
+struct AlphaMapFiles {
+  std::string exr, png;
+};
+AlphaMapFiles encodeAlphaMaps(const Scene& scene, const Rendering& rendering);
+
+// Writes encodeAlphaMaps's files: the EXR to `path`, the PNG to alphaPngPath(path).
 void writeAlphaMaps(const std::string& path, const Scene& scene, const Rendering& rendering);
 
 std::string alphaPngPath(const std::string& exrPath);

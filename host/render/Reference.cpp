@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "Error.h"
 #include "render/Method.h"
 
 namespace misalloc {
@@ -67,10 +68,12 @@ RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uin
 
 std::string referenceKey(const Scene& scene, int spp) {
   Fnv1a h;
-  const RgbImage& env = scene.envmap.image;
+  const EnvmapTables& env = scene.tables;
   h.addValue(env.width);
   h.addValue(env.height);
-  h.add(env.rgb.data(), env.rgb.size() * sizeof(float));
+  // The texels' RGB in order, without their probabilities: the same bytes as the
+  // envmap's image, so keys outlive the change from hashing the image.
+  for (size_t t = 0; t < env.texels.size(); t += 4) h.add(&env.texels[t], 3 * sizeof(float));
   h.addValue(scene.envmap.coskExponent);
   h.add(scene.grid.spec);
   h.addValue(scene.grid.width);
@@ -97,7 +100,11 @@ std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene
   if (!computeIfMissing) return std::nullopt;
   // A seed of its own (top bit set), so a render with a small seed is independent of it.
   RgbImage image = sampleReference(sampler, scene, spp, 0x8000000000005eedull);
-  fs::create_directories(path.parent_path());
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  if (ec)
+    throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, path.parent_path().string(),
+                                 ec.message()));
   writeExr(path.string(), image);
   return Reference{image, source, path.string()};
 }

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <numeric>
 
 #include "Error.h"
@@ -153,20 +154,20 @@ namespace {
 
 // The order in which work-items take pixels. A work-group runs each technique's loop
 // for its largest count (kernels/sample.cl, sampleStage), so pixels with like counts
-// share work-groups: sorted by (n_0, …, n_{M−2}) with a stable counting sort, ties
+// share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort, ties
 // by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
 // work-group, so the order changes the time only, never the result.
 std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, int pixels) {
-  std::vector<int32_t> order(pixels), sorted(pixels);
+  std::vector<int32_t> order(pixels);
   std::iota(order.begin(), order.end(), 0);
-  const int M = plan.techniqueCount;
-  for (int k = M - 2; k >= 0; --k) {  // least significant key first
-    std::vector<int> start(size_t(plan.stageSamples) + 2, 0);
-    for (int p : order) ++start[plan.counts[size_t(p) * M + k] + 1];
-    std::partial_sum(start.begin(), start.end(), start.begin());
-    for (int p : order) sorted[start[plan.counts[size_t(p) * M + k]]++] = p;
-    order.swap(sorted);
-  }
+  const size_t M = size_t(plan.techniqueCount);
+  // A comparison sort: its memory scales with the pixels, where a counting sort's
+  // buckets 0..N took 4 bytes per sample of the stage.
+  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+    const int* countsA = plan.counts.data() + size_t(a) * M;
+    const int* countsB = plan.counts.data() + size_t(b) * M;
+    return std::lexicographical_compare(countsA, countsA + M - 1, countsB, countsB + M - 1);
+  });
   return order;
 }
 

@@ -15,11 +15,16 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxProceduralWidth = 16384;  // 16384 × 8192 texels: 1.5 GiB of RGB floats
+// The brightest radiance rendered. A sample reaches about 3e6 times the radiance
+// (Phong lobes up to n = 1e5, 4π sr, a blue texel whose luminance is 7 % of its
+// value), so 1e30 keeps samples two orders below float's 3.4e38, where a brighter
+// map would write Inf pixels; tests/test_stability.cpp renders 1e30 finite and unbiased.
+constexpr double kMaxRadiance = 1e30;
 constexpr char kAcceptedForms[] =
     "accepted forms: PATH (an OpenEXR file), constant, constant:R, cosk:K, sun, sun:THETA,PHI,RADIUS,RATIO";
 
 InputError badSpec(const std::string& spec, const std::string& problem) {
-  return InputError(fmt::format("envmap '{}': {}; {}", spec, problem, kAcceptedForms));
+  return InputError(fmt::format("--envmap {}: {}; {}", spec, problem, kAcceptedForms));
 }
 
 // Comma-separated finite numbers, exactly `count` of them.
@@ -226,6 +231,20 @@ Envmap proceduralMap(const std::string& name, const std::string& arguments, bool
   return sunMap(p[0], p[1], p[2], p[3], width);
 }
 
+// Refuses a map brighter than kMaxRadiance, naming its first such value; a procedural
+// map that overflowed float on rasterising is caught here too, as Inf.
+void refuseOverflowingRadiance(const RgbImage& image, const std::string& spec) {
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+    if (image.rgb[i] <= float(kMaxRadiance)) continue;
+    std::size_t pixel = i / 3;
+    TexelLocation at{int(pixel % std::size_t(image.width)), int(pixel / std::size_t(image.width)), "RGB"[i % 3]};
+    throw InputError(fmt::format(
+        "--envmap {}: radiance {:g} at {} exceeds {:g}, the brightest that renders without overflowing float; "
+        "scale the map down",
+        spec, image.rgb[i], toString(at), kMaxRadiance));
+  }
+}
+
 }  // namespace
 
 Envmap makeEnvmap(const std::string& spec, int proceduralWidth, ReadWarnings* warnings) {
@@ -241,6 +260,7 @@ Envmap makeEnvmap(const std::string& spec, int proceduralWidth, ReadWarnings* wa
     map.image = readExr(spec, warnings);
     map.description = spec;
   }
+  refuseOverflowingRadiance(map.image, spec);
   map.description += fmt::format(" ({}×{})", map.image.width, map.image.height);
   return map;
 }

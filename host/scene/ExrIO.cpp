@@ -18,6 +18,7 @@
 
 #include "AtomicFile.h"
 #include "Error.h"
+#include "MemoryBudget.h"
 
 namespace misalloc {
 namespace {
@@ -66,6 +67,8 @@ RgbImage readRgbPixels(const std::string& path) {
   RgbImage image;
   image.width = window.max.x - window.min.x + 1;
   image.height = window.max.y - window.min.y + 1;
+  requireHostMemory(fmt::format("'{}' ({}×{} texels × 12 B)", path, image.width, image.height),
+                    double(image.width) * image.height * 3 * sizeof(float));
   image.rgb.resize(std::size_t(image.width) * std::size_t(image.height) * 3);
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
@@ -117,14 +120,23 @@ class MemoryOStream : public Imf::OStream {
   std::size_t position_ = 0;
 };
 
-void writeAtomically(const std::string& path, const Imf::Header& header, const Imf::FrameBuffer& frame) {
+std::string encode(const Imf::Header& header, const Imf::FrameBuffer& frame) {
   MemoryOStream stream;
   {
     Imf::OutputFile file(stream, header);
     file.setFrameBuffer(frame);
     file.writePixels(header.dataWindow().max.y - header.dataWindow().min.y + 1);
   }  // the destructor writes the line offset table
-  writeFileAtomically(path, stream.bytes());
+  return stream.bytes();
+}
+
+// A written image is always finite: an overflow upstream is a bug to report, not a
+// file to leave for the next tool to trip on.
+void requireFinite(const float* values, std::size_t count, const std::string& what) {
+  std::size_t bad = 0;
+  for (std::size_t i = 0; i < count; ++i) bad += std::isfinite(values[i]) ? 0 : 1;
+  if (bad > 0)
+    throw std::runtime_error(fmt::format("{} holds {} NaN or infinite values; not written", what, bad));
 }
 
 Imf::Header floatHeader(int width, int height, const std::vector<std::string>& names) {
@@ -156,7 +168,7 @@ RgbImage readExr(const std::string& path, ReadWarnings* warnings) {
   return image;
 }
 
-void writeExr(const std::string& path, const RgbImage& image) {
+std::string encodeExr(const RgbImage& image) {
   if (image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(
         fmt::format("RgbImage {}×{} holds {} floats, not 3 per pixel", image.width, image.height, image.rgb.size()));
@@ -166,11 +178,14 @@ void writeExr(const std::string& path, const RgbImage& image) {
   for (int c = 0; c < 3; ++c)
     frame.insert(std::string(1, kRgbNames[c]), Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, header.dataWindow(),
                                                                 pixelBytes, pixelBytes * std::size_t(image.width)));
-  writeAtomically(path, header, frame);
+  requireFinite(image.rgb.data(), image.rgb.size(), fmt::format("the {}×{} image", image.width, image.height));
+  return encode(header, frame);
 }
 
-void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
-                      const std::vector<std::vector<float>>& planes) {
+void writeExr(const std::string& path, const RgbImage& image) { writeFileAtomically(path, encodeExr(image)); }
+
+std::string encodeExrChannels(int width, int height, const std::vector<std::string>& names,
+                              const std::vector<std::vector<float>>& planes) {
   if (names.empty() || names.size() != planes.size())
     throw std::invalid_argument(fmt::format("{} channel names for {} planes", names.size(), planes.size()));
   if (std::set<std::string>(names.begin(), names.end()).size() != names.size())
@@ -181,9 +196,15 @@ void writeExrChannels(const std::string& path, int width, int height, const std:
     if (planes[k].size() != std::size_t(width) * std::size_t(height))
       throw std::invalid_argument(
           fmt::format("plane '{}' holds {} values, not {}×{}", names[k], planes[k].size(), width, height));
+    requireFinite(planes[k].data(), planes[k].size(), fmt::format("channel '{}'", names[k]));
     frame.insert(names[k], Imf::Slice::Make(Imf::FLOAT, planes[k].data(), header.dataWindow()));
   }
-  writeAtomically(path, header, frame);
+  return encode(header, frame);
+}
+
+void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
+                      const std::vector<std::vector<float>>& planes) {
+  writeFileAtomically(path, encodeExrChannels(width, height, names, planes));
 }
 
 }  // namespace misalloc

@@ -34,13 +34,21 @@ struct ReadWarnings {
 // lacks R, G or B, has an empty data window, or holds NaN or infinite values.
 RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr);
 
-// Writes float R, G, B with ZIP compression. Both writers encode the whole file in
-// memory and replace `path` with writeFileAtomically, so a failure (InputError) never
-// leaves a partial file or damages an existing one.
+// The bytes of an OpenEXR file of float R, G, B with ZIP compression. Both encoders
+// refuse (std::runtime_error) values that are NaN or infinite: a written image is
+// always finite.
+std::string encodeExr(const RgbImage& image);
+
+// Writes encodeExr's bytes through writeFileAtomically, so a failure (InputError)
+// never leaves a partial file or damages an existing one.
 void writeExr(const std::string& path, const RgbImage& image);
 
-// Writes one float channel per plane (width × height values, row 0 first), named by
+// One float channel per plane (width × height values, row 0 first), named by
 // `names`, e.g. per-pixel allocation maps.
+std::string encodeExrChannels(int width, int height, const std::vector<std::string>& names,
+                              const std::vector<std::vector<float>>& planes);
+
+// Writes encodeExrChannels's bytes through writeFileAtomically.
 void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
                       const std::vector<std::vector<float>>& planes);
 

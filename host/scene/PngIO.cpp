@@ -1,5 +1,6 @@
 #include "scene/PngIO.h"
 
+#include <fmt/format.h>
 #include <png.h>
 
 #include <stdexcept>
@@ -15,7 +16,7 @@ void appendToString(png_structp png, png_bytep data, png_size_t length) {
 
 }  // namespace
 
-void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
+std::string encodePng(int width, int height, const std::vector<uint8_t>& rgb) {
   if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("writePng: wrong pixel count");
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -26,7 +27,7 @@ void writePng(const std::string& path, int width, int height, const std::vector<
   std::string encoded;
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("libpng failed to encode " + path);
+    throw std::runtime_error(fmt::format("libpng failed to encode a {}×{} image", width, height));
   }
   png_set_write_fn(png, &encoded, appendToString, nullptr);
   png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
@@ -35,7 +36,11 @@ void writePng(const std::string& path, int width, int height, const std::vector<
   for (int y = 0; y < height; ++y) png_write_row(png, const_cast<png_bytep>(rgb.data() + size_t(y) * width * 3));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  writeFileAtomically(path, encoded);
+  return encoded;
+}
+
+void writePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
+  writeFileAtomically(path, encodePng(width, height, rgb));
 }
 
 }  // namespace misalloc
