@@ -60,7 +60,7 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--method magic", "unknown --method 'magic'"},
       {"--method exact --spp 40 --grid-u 1", "--grid-u: '1'"},
       {"--method exact --spp 40 --grid-rule best", "--grid-rule 'best'"},
-      {"--method heuristic --spp 5", "smaller than the pilot"},
+      {"--method heuristic --spp 4", "smaller than the pilot"},
       {"--method heuristic --spp 40 --cost 1,0", "costs must be positive"},
       {"--method heuristic --spp 40 --cost 1", "expected 2 numbers"},
       {"--method heuristic --pilot 1.5", "--pilot: '1.5'"},
