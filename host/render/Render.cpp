@@ -176,8 +176,8 @@ std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method
 
 // The next stage's counts: the stage split by the current α. Each stage is its own
 // balance-heuristic estimate with its own counts, weighted N_b/N, so the render's
-// variance is Σ_b (N_b/N)² V(α_b)/N_b: each stage is best split by the best α known
-// ([HS14] eq. 4.5 per stage; tests/test_adaptive.cpp compares it with making the
+// variance is Σ_b (N_b/N)² V(α_b)/N_b ([SHS16] eq. 21 per stage): each stage is best
+// split by the best α known (tests/test_staging.cpp compares it with making the
 // cumulative counts approach α·N).
 std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocation>& allocations, int stageSamples) {
   const int M = int(progress.taken.size() / progress.fellBack.size());
@@ -226,6 +226,8 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   return config;
 }
 
+namespace {
+
 void validateAdaptiveOptions(const AdaptiveOptions& options) {
   if (options.poolRadius < 0) throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
   if (!(options.minGain >= 0 && options.minGain < 1))
@@ -233,6 +235,8 @@ void validateAdaptiveOptions(const AdaptiveOptions& options) {
   if (options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)
     throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
 }
+
+}  // namespace
 
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed) {
   auto start = Clock::now();
