@@ -71,7 +71,8 @@ TEST_CASE("L̄ of a cos^K map is 1/(2(K+1)) and the compensated pdf drops every 
       Scene scene = compensatedScene(fmt::format("cosk:{}", K), "uniform:0.5,0.5,5", "compensated", sampler, false, 2);
       const EnvmapTables& t = scene.tables;
       INFO(fmt::format("K {} cdf {}", K, t.useCdf));
-      CHECK(t.meanLuminance == Approx(1 / (2 * (K + 1))).epsilon(1e-5));
+      // The rasteriser's texel averages take the midpoint rule over 16 sub-rows.
+      CHECK(t.meanLuminance == Approx(1 / (2 * (K + 1))).epsilon(1e-4));
       REQUIRE(t.pdf.compensated());
       const double threshold = 2 * (1 - 0.5) * t.meanLuminance;
       double sum = 0, zeros = 0;
