@@ -14,6 +14,7 @@
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "compare/EnvmapPdfComparison.h"
 #include "render/BrdfCoverage.h"
 #include "render/Reference.h"
 #include "render/Render.h"
@@ -193,4 +194,71 @@ TEST_CASE("every method is unbiased with the compensated pdf against 000 eq. 6.1
         }
       }
   }
+}
+
+TEST_CASE("compare runs each scene with each envmap pdf and compares them with equal and plain",
+          "[compensated][compare]") {
+  auto runRecord = [](const std::string& label, Method m, int budget, int repeat, double seconds, double mse) {
+    RunRecord r;
+    r.caseLabel = label;
+    r.method = m;
+    r.budget = budget;
+    r.repeat = repeat;
+    r.wallSeconds = r.kernelSeconds = seconds;
+    r.mse = mse;
+    r.meanAlpha = {0.5, 0.5};
+    return r;
+  };
+  // Two pdfs of one scene: the compensated one halves equal's MSE at the same times, so
+  // under the Monte Carlo law MSE ∝ 1/t plain equal needs twice as long.
+  Comparison c;
+  for (const char* pdf : {"plain", "compensated:0.5"}) {
+    nlohmann::json scene = {{"envmap", "m"}, {"envmap_pdf", {{"requested", pdf}}}};
+    const std::string label = std::string("m-") + pdf;
+    c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
+    for (int budget : {10, 20})
+      c.runs.push_back(runRecord(label, Method::Equal, budget, 0, 0.01 * budget,
+                                 (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));
+  }
+  CompareOptions o;
+  o.methods = {Method::Equal};
+  o.budgets = {10, 20};
+  o.repeats = 1;
+  o.tableBudget = 20;
+  Summary s = summarize(c, o);
+  TextTable t = envmapPdfSpeedUpTable(s, 20);
+  REQUIRE(t.rows.size() == 2);
+  CHECK(t.header == std::vector<std::string>{"method", "pdf", "m-plain", "geometric mean"});
+  CHECK(t.rows[0][1].text == "plain");
+  CHECK(t.rows[0][2].text == "1.00");
+  CHECK(t.rows[1][1].text == "compensated:0.5");
+  CHECK(t.rows[1][2].text == "~2.00");  // below plain's least error: read past its curve's end
+  CHECK(envmapPdfMarkdown(s).find("speed-up over equal with the plain pdf") != std::string::npos);
+
+  CHECK(parseEnvmapPdfList("plain,compensated:0.25").size() == 2);
+  CHECK_THROWS_WITH(parseEnvmapPdfList("compensated,compensated:0.5"), Catch::Contains("listed twice"));
+  std::vector<CompareCase> cases = casesPerEnvmapPdf({{"x", SceneOptions{}}}, parseEnvmapPdfList("plain,compensated"));
+  REQUIRE(cases.size() == 2);
+  CHECK(cases[0].label == "forest_slope");
+  CHECK(cases[1].label == "forest_slope-comp0.5");
+
+  TempDir dir("compare_pdfs");
+  const auto out = dir.path / "out";
+  auto r =
+      runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 --methods equal,brdf "
+                              "--envmap-pdfs plain,compensated --device cpu --out-dir {} --cache-dir {}",
+                              out.string(), (dir.path / "cache").string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  CHECK(std::filesystem::exists(out / "envmap_pdfs.md"));
+  CHECK(std::filesystem::exists(out / "cosk_2-comp0.5/equal_20spp.exr"));
+  nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
+  CHECK(runs["runs"].size() == 2 * 2 * 2 * 2);
+  CHECK(runs["cases"][1]["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
+  CHECK(runs["cases"][1]["reference"] == "analytic (000 eq. 6.17)");
+
+  auto refused = runMisalloc(fmt::format(
+      "compare --envmap cosk:2 --size 8x8 --budgets 10 --envmap-pdfs plain,compensated --out-dir {}", out.string()));
+  CHECK(refused.exitCode == 2);
+  CHECK(refused.output.find("--method envmap with --envmap-pdf compensated:0.5") != std::string::npos);
 }
