@@ -1,10 +1,13 @@
 // What the envmap pdf of [Kar19] costs: building each map's tables (texel probabilities
 // and the alias table or CDFs) with the plain and the compensated pdf, against one
 // 256×256, 200 spp `equal` render of the default scene. The compensated pdf adds L̄ and
-// the subtraction of eq. 14 to the build; sampling with it costs what sampling with the
-// plain pdf does (the same kernel reads the same tables).
+// the subtraction of eq. 14 to the build; sampling with it should cost what sampling
+// with the plain pdf does (the same kernel reads tables of the same size), which the
+// renders of each map with each pdf check. Run with interleaved repetitions, so that a
+// machine whose load changes slows both pdfs alike:
 //
-//   build/bench/misalloc_bench_envmap_pdf [--device cpu] [google benchmark flags]
+//   build/bench/misalloc_bench_envmap_pdf [--device cpu] --benchmark_repetitions=3
+//       --benchmark_enable_random_interleaving=true [google benchmark flags]
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -33,11 +36,16 @@ void benchTables(benchmark::State& state, const std::string& map, const std::str
   for (auto _ : state) benchmark::DoNotOptimize(buildEnvmapTables(envmap, sampler, parsed));
 }
 
-void benchRender(benchmark::State& state) {
+// One 256×256, 200 spp `equal` render of `map` × seed000 with `pdf`, per iteration. Both
+// pdfs run the same kernel on tables of the same size: their times should agree, so
+// that equal samples are equal time, as [Kar19] Sec. 7 reports.
+void benchRender(benchmark::State& state, const std::string& map, const std::string& pdf) {
   static const Device device = openDevice(deviceSpec);
   SceneOptions o;
+  o.envmap = map;
   o.width = o.height = 256;
-  static const Scene scene = makeScene(o);
+  o.envmapPdf = parseEnvmapPdf(pdf);
+  const Scene scene = makeScene(o);
   Sampler sampler(device, scene, samplerConfigFor(Method::Equal, Estimator::MultiSample, 200, {}));
   render(sampler, Method::Equal, {}, 200, 1);  // warm-up
   uint64_t seed = 2;
@@ -66,8 +74,11 @@ int main(int argc, char** argv) {
             [map, pdf, sampler](benchmark::State& s) { benchTables(s, map, pdf, sampler); })
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
-  benchmark::RegisterBenchmark("render/equal/256x256/200spp", benchRender)
-      ->Unit(benchmark::kMillisecond)
-      ->UseRealTime();
+  for (const std::string& map : maps)
+    for (const char* pdf : {"plain", "compensated"})
+      benchmark::RegisterBenchmark(("render/" + map + "/" + pdf + "/equal/256x256/200spp").c_str(),
+                                   [map, pdf](benchmark::State& s) { benchRender(s, map, pdf); })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   benchmark::RunSpecifiedBenchmarks();
 }

@@ -39,8 +39,8 @@ struct EnvmapTables {
 };
 
 // Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B (compensated with
-// `pdf`) times sin θ at the texel's centre, so that the solid-angle pdf is ∝ luminance. Probabilities and
-// prefix sums are computed in double and stored as float; a texel of weight 0 is never
+// `pdf`) times sin θ at the texel's centre, so that the solid-angle pdf is ∝ luminance
+// (compensated). Probabilities and prefix sums are computed in double and stored as float; a texel of weight 0 is never
 // drawn by either sampler. The alias sampler stores the weights' probabilities. The
 // CDF sampler stores the probabilities its float CDFs realise with the kernel's 24-bit
 // uniforms: they differ from the weights' by up to ~2^-24 (W+H) in total, and an
