@@ -19,11 +19,13 @@
 #include "cl/Device.h"
 #include "compare/CompareReport.h"
 #include "compare/Comparison.h"
+#include "compare/EnvmapPdfComparison.h"
 #include "compare/Suite.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
 #include "paper/PaperReport.h"
 #include "render/AlphaMap.h"
+#include "render/BrdfCoverage.h"
 #include "render/Costs.h"
 #include "render/ImageMetrics.h"
 #include "render/Method.h"
@@ -39,7 +41,7 @@ namespace {
 
 struct SceneArgs {
   SceneOptions options;
-  std::string size = "128x128", view = "0", sampler = "alias";
+  std::string size = "128x128", view = "0", sampler = "alias", envmapPdf = "plain";
 
   void add(CLI::App* app) {
     app->add_option("--envmap", options.envmap,
@@ -57,7 +59,8 @@ struct SceneArgs {
         ->check(integerIn(2, 16384));
   }
 
-  // The options with --size, --view and --envmap-sampler parsed; throws InputError.
+  // The options with --size, --view, --envmap-sampler and --envmap-pdf parsed; throws
+  // InputError.
   SceneOptions parsed() {
     std::tie(options.width, options.height) = parseImageSize(size);
     const double pixels = double(options.width) * options.height;
@@ -68,7 +71,16 @@ struct SceneArgs {
     options.viewTheta = angles[0];
     options.viewPhi = angles.size() > 1 ? angles[1] : 0;
     options.sampler = parseEnvmapSampler(sampler);
+    options.envmapPdf = parseEnvmapPdf(envmapPdf);
     return options;
+  }
+
+  // [Kar19]: render only; a reference is equal MIS with the plain pdf, compare takes a list.
+  void addEnvmapPdf(CLI::App* app) {
+    app->add_option("--envmap-pdf", envmapPdf,
+                    "plain (∝ luminance) or compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C "
+                    "default 0.5)")
+        ->capture_default_str();
   }
 
   Scene make() {
@@ -81,6 +93,11 @@ struct SceneArgs {
     if (scene.tables.uniformFallback)
       std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: its sampling falls back to uniform\n",
                                options.envmap);
+    if (scene.tables.requestedPdf.compensated() && !scene.tables.pdf.compensated())
+      std::cerr << fmt::format(
+          "misalloc: warning: envmap '{}': no texel exceeds 2(1-C) times the mean luminance; "
+          "--envmap-pdf {} falls back to plain\n",
+          options.envmap, envmapPdfName(scene.tables.requestedPdf));
     return scene;
   }
 };
@@ -241,6 +258,7 @@ int main(int argc, char** argv) {
   auto* renderCmd = app.add_subcommand("render", "render a scene (default: forest_slope x seed000, 128x128, 200 spp)");
   SceneArgs renderScene;
   renderScene.add(renderCmd);
+  renderScene.addEnvmapPdf(renderCmd);
   int spp = 200, localSize = 8, referenceSpp = 16384;
   uint64_t seed = 1;
   std::string method = "equal", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
@@ -287,12 +305,15 @@ int main(int argc, char** argv) {
   AdaptiveArgs compareAdaptive;
   compareAdaptive.add(compareCmd);
   CompareOptions compare;
-  std::string methodList = "all", budgetList = "50,100,200,400,800";
+  std::string methodList = "all", budgetList = "50,100,200,400,800", envmapPdfList = "plain";
   bool suite = false;
   compareCmd->add_flag("--suite", suite,
                        "every shipped envmap x seed000 plus forest_slope with the cdf sampler, at 64x64 unless --size");
   compareCmd->add_option("--methods", methodList, "comma-separated methods, or all")->capture_default_str();
   compareCmd->add_option("--budgets", budgetList, "samples per pixel, ascending")->capture_default_str();
+  compareCmd
+      ->add_option("--envmap-pdfs", envmapPdfList, "envmap pdfs, each scene runs with each: plain, compensated[:C]")
+      ->capture_default_str();
   compareCmd->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
       ->capture_default_str()
       ->check(integerIn(1, INT_MAX));
@@ -345,6 +366,7 @@ int main(int argc, char** argv) {
       }
       Scene scene = renderScene.make();
       AdaptiveOptions adaptive = renderAdaptive.make(scene.techniqueCount());
+      requireBrdfCoverage(scene.options.envmapPdf, scene.techniqueCount(), m, estimator, spp, adaptive);
       std::string costSource = adaptive.costs.empty() ? "measured" : "--cost";
       if (isAdaptive(m) && m != Method::Oracle)
         stageSizes(adaptive.pilotFraction, adaptive.stages, spp, scene.techniqueCount());
@@ -358,13 +380,14 @@ int main(int argc, char** argv) {
       std::string deviceName = samplerDeviceName(device);
       // Without statistics: for the reference and for measuring costs.
       std::unique_ptr<StageSampler> plain;
+      const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
       auto plainSampler = [&]() -> StageSampler& {
-        if (!plain) plain = makeStageSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
+        if (!plain) plain = makeStageSampler(deviceSpec, device, plainScene, SamplerConfig{}, localSize);
         return *plain;
       };
       std::optional<Reference> reference;
       if (referenceMode == "auto")
-        reference = findReference(plainSampler(), scene, referenceSpp, cacheDir, true);
+        reference = findReference(plainSampler(), plainScene, referenceSpp, cacheDir, true);
       else if (referenceMode != "none")
         reference = Reference{readExr(referenceMode), "file", referenceMode};
       if (reference) checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
@@ -407,6 +430,7 @@ int main(int argc, char** argv) {
         Scene probe = compareScene.make();  // reads the envmap once, so bad input fails before any work
         compare.cases.push_back({caseLabel(probe.options), probe.options});
       }
+      compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(envmapPdfList));
       compare.methods = parseMethodList(methodList);
       compare.budgets = parseBudgets(budgetList);
       compare.adaptive = compareAdaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
@@ -415,6 +439,7 @@ int main(int argc, char** argv) {
         for (Method m : compare.methods)
           for (int budget : compare.budgets)
             requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, compare.device);
+      requireBrdfCoverage(compare);
       std::vector<SceneOptions> scenes;
       for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
       OutputSet outputs(envmapInputs(scenes));
@@ -423,13 +448,15 @@ int main(int argc, char** argv) {
       Comparison comparison = runComparison(compare, guard);
       Summary summary = summarize(comparison, compare);
       writeCompareReport(summary, compare.outDir);
+      const std::string envmapPdfTables = envmapPdfMarkdown(summary);
+      if (!envmapPdfTables.empty()) writeFileAtomically(compare.outDir + "/envmap_pdfs.md", envmapPdfTables);
       outputs.commit();
       if (comparison.interrupted) {
         std::cerr << fmt::format("misalloc: interrupted after {} runs; {} holds them, every file complete\n",
                                  comparison.runs.size(), outDir);
         return 130;
       }
-      std::cout << summaryMarkdown(summary);
+      std::cout << summaryMarkdown(summary) << envmapPdfTables;
       std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n",
                                outDir);
     } else if (app.got_subcommand("reference")) {

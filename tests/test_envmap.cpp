@@ -385,40 +385,42 @@ TEST_CASE("envmapLookup at a texel's centre returns that texel's radiance and pd
 }
 
 TEST_CASE("the kernels' samplers draw texels with the stored probabilities, never one of weight 0", "[envmap]") {
-  for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
-    const bool cdf = sampler == EnvmapSampler::Cdf;
-    for (const auto& [name, map] : testMaps()) {
-      INFO(name << (cdf ? ", CDF" : ", alias"));
-      EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler);
-      std::vector<double> p = texelProbabilities(tables);
+  // The compensated pdf ([Kar19] eq. 14) zeroes every texel at or below the mean.
+  for (const std::string pdf : {"plain", "compensated"})
+    for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      const bool cdf = sampler == EnvmapSampler::Cdf;
+      for (const auto& [name, map] : testMaps()) {
+        INFO(name << (cdf ? ", CDF, " : ", alias, ") << pdf);
+        EnvmapTables tables = misalloc::buildEnvmapTables(map, sampler, misalloc::parseEnvmapPdf(pdf));
+        std::vector<double> p = texelProbabilities(tables);
 
-      // Exactly, over every value of the random numbers. The CDF sampler stores the
-      // probabilities it draws, rounded to float once. Each acceptance probability is
-      // off by at most one float rounding and one step of the 2^-24 grid, and
-      // mul_hi's buckets are uniform only when N divides 2^32.
-      std::vector<double> exact = kernelTexelDistribution(tables);
-      double bucketBias = 0;
-      for (std::size_t i = 0; i < p.size(); ++i)
-        bucketBias += std::abs(aliasBucketProbability(i, p.size()) - 1.0 / p.size());
-      double bound = cdf ? kFloatRounding : 3 * kFloatRounding + bucketBias;
-      CHECK(totalVariation(exact, p) <= bound);
-      for (std::size_t t = 0; t < p.size(); ++t)
-        if (p[t] == 0) CHECK(exact[t] == 0);
+        // Exactly, over every value of the random numbers. The CDF sampler stores the
+        // probabilities it draws, rounded to float once. Each acceptance probability is
+        // off by at most one float rounding and one step of the 2^-24 grid, and
+        // mul_hi's buckets are uniform only when N divides 2^32.
+        std::vector<double> exact = kernelTexelDistribution(tables);
+        double bucketBias = 0;
+        for (std::size_t i = 0; i < p.size(); ++i)
+          bucketBias += std::abs(aliasBucketProbability(i, p.size()) - 1.0 / p.size());
+        double bound = cdf ? kFloatRounding : 3 * kFloatRounding + bucketBias;
+        CHECK(totalVariation(exact, p) <= bound);
+        for (std::size_t t = 0; t < p.size(); ++t)
+          if (p[t] == 0) CHECK(exact[t] == 0);
 
-      // Statistically, through the kernels' functions and random numbers.
-      kern::EnvmapView view = viewOf(tables);
-      const uint64_t samples = 1000000;
-      std::vector<uint64_t> counts(p.size(), 0);
-      for (uint64_t i = 0; i < samples; ++i)
-        ++counts[sampledTexel(view, kern::philoxDraw(0x5eed, cdf ? 1 : 0, 0, 0, uint32_t(i)))];
-      uint64_t zeroWeightDraws = 0;
-      for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
-      CHECK(zeroWeightDraws == 0);
-      ChiSquare test = chiSquare(counts, p, samples);
-      INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
-      if (test.degreesOfFreedom > 0) CHECK(test.pValue() > kPValueThreshold);
+        // Statistically, through the kernels' functions and random numbers.
+        kern::EnvmapView view = viewOf(tables);
+        const uint64_t samples = 1000000;
+        std::vector<uint64_t> counts(p.size(), 0);
+        for (uint64_t i = 0; i < samples; ++i)
+          ++counts[sampledTexel(view, kern::philoxDraw(0x5eed, cdf ? 1 : 0, 0, 0, uint32_t(i)))];
+        uint64_t zeroWeightDraws = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
+        CHECK(zeroWeightDraws == 0);
+        ChiSquare test = chiSquare(counts, p, samples);
+        INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
+        if (test.degreesOfFreedom > 0) CHECK(test.pValue() > kPValueThreshold);
+      }
     }
-  }
 }
 
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {

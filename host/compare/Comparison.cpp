@@ -151,10 +151,13 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
   for (const CompareCase& c : options.cases) {
     Scene scene = makeScene(c.scene);
     fs::create_directories(fs::path(options.outDir) / c.label);
-    auto plain = makeStageSampler(options.device, device, scene, SamplerConfig{}, options.localSize);
+    // The reference and the costs with the plain envmap pdf ([Kar19]: withPlainEnvmapPdf).
+    const Scene plainScene = withPlainEnvmapPdf(scene);
+    auto plain = makeStageSampler(options.device, device, plainScene, SamplerConfig{}, options.localSize);
     meter.note(
         fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
-    std::optional<Reference> reference = findReference(*plain, scene, options.referenceSpp, options.cacheDir, true);
+    std::optional<Reference> reference =
+        findReference(*plain, plainScene, options.referenceSpp, options.cacheDir, true);
     AdaptiveOptions adaptive = options.adaptive;
     bool measured = adaptive.costs.empty();
     if (measured) adaptive.costs = measureCosts(*plain);

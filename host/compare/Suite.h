@@ -13,7 +13,8 @@ namespace misalloc {
 std::vector<CompareCase> suiteCases(int width, int height);
 
 // A column label for a scene: the envmap's name (file name without .exr, or the
-// procedural spec), "-cdf" with the binary-search sampler, "-split" for M = 3; only
+// procedural spec), "-cdf" with the binary-search sampler, "-split" for M = 3,
+// "-compC" with the compensated envmap pdf of envmap fraction C ([Kar19]); only
 // letters, digits, '.', '_' and '-', so that it also names a folder.
 std::string caseLabel(const SceneOptions& scene);
 

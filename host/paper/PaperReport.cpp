@@ -9,6 +9,7 @@
 
 #include "alloc/HeuristicAllocation.h"
 #include "alloc/SigmaAllocation.h"
+#include "paper/Flatland.h"
 #include "paper/MixtureOptimizer.h"
 #include "paper/MixtureVariance.h"
 #include "paper/MonteCarloStudy.h"
@@ -183,6 +184,61 @@ Values values003(int n) {
   return v;
 }
 
+// [Kar19] Sec. 6.3, on map A (paper/Flatland.h).
+constexpr const char* kFlatlandId = "001-6.3";
+constexpr const char* kFlatlandTitle =
+    "001 Sec. 6.3: flatland MIS compensation, HDR map x diffuse or sharp BRDF, c = 0.5 (map A of "
+    "verified_values.json stands in for the paper's)";
+
+Values values001Flatland() {
+  FlatlandStudy diffuse(FlatlandBrdf::Diffuse), sharp(FlatlandBrdf::Sharp);
+  auto gain = [](const FlatlandStudy& s, FlatlandPdf pdf) {
+    return s.variance(FlatlandPdf::Original).oneSample / s.variance(pdf).oneSample;
+  };
+  auto withinBounds = [](const FlatlandLambda& l) { return l.lower <= l.lambda && l.lambda <= l.upper; };
+  Values v;
+  v["diffuse, one-sample: NMSE(HDR only) / NMSE(MIS)"] =
+      number(diffuse.hdrOnly() / diffuse.variance(FlatlandPdf::Original).oneSample);
+  v["diffuse, one-sample gain over MIS: practical-ni"] = number(gain(diffuse, FlatlandPdf::PracticalNi));
+  v["diffuse, one-sample gain over MIS: practical-nd"] = number(gain(diffuse, FlatlandPdf::PracticalNd));
+  v["diffuse, one-sample gain over MIS: MIS-compensated"] = number(gain(diffuse, FlatlandPdf::Compensated));
+  v["diffuse, one-sample gain over MIS: optimal"] = number(gain(diffuse, FlatlandPdf::Optimal));
+  v["sharp, one-sample gain over MIS: practical-ni, practical-nd"] =
+      numbers({gain(sharp, FlatlandPdf::PracticalNi), gain(sharp, FlatlandPdf::PracticalNd)});
+  v["sharp, one-sample: MIS-compensated vs BRDF only"] =
+      number(sharp.brdfOnly() / sharp.variance(FlatlandPdf::Compensated).oneSample);
+  v["sharp, one-sample: MIS-compensated vs MIS"] = number(gain(sharp, FlatlandPdf::Compensated));
+  v["int (p_comp - p_opt)^2 / int p_opt^2 (diffuse, sharp)"] =
+      numbers({diffuse.compensatedVsOptimal(), sharp.compensatedVsOptimal()});
+  v["lambda in [c F^2, F^2/c], eq. 10 (diffuse, sharp)"] =
+      fmt::format("{} ({} in [{}, {}]), {} ({} in [{}, {}])", withinBounds(diffuse.lambda()) ? "holds" : "fails",
+                  number(diffuse.lambda().lambda), number(diffuse.lambda().lower), number(diffuse.lambda().upper),
+                  withinBounds(sharp.lambda()) ? "holds" : "fails", number(sharp.lambda().lambda),
+                  number(sharp.lambda().lower), number(sharp.lambda().upper));
+  return v;
+}
+
+// Every pdf's normalised variance (N = 1) for both BRDFs, one- and multi-sample.
+void printFlatlandTable(std::ostream& out) {
+  const std::pair<FlatlandPdf, const char*> pdfs[] = {{FlatlandPdf::Original, "HDR map (original)"},
+                                                      {FlatlandPdf::PracticalNi, "practical-ni (eq. 14)"},
+                                                      {FlatlandPdf::PracticalNd, "practical-nd (eq. 13)"},
+                                                      {FlatlandPdf::Compensated, "MIS-compensated (eq. 6)"},
+                                                      {FlatlandPdf::Optimal, "optimal (eq. 9)"}};
+  out << fmt::format("\n  NMSE (N = 1) with the balance heuristic, c = 0.5:\n  {:<26} {:>14} {:>14} {:>14} {:>14}\n",
+                     "HDR-map pdf", "diffuse, one", "diffuse, multi", "sharp, one", "sharp, multi");
+  FlatlandStudy diffuse(FlatlandBrdf::Diffuse), sharp(FlatlandBrdf::Sharp);
+  for (auto [pdf, name] : pdfs) {
+    FlatlandVariance d = diffuse.variance(pdf), s = sharp.variance(pdf);
+    out << fmt::format("  {:<26} {:>14} {:>14} {:>14} {:>14}\n", name, number(d.oneSample), number(d.multiSample),
+                       number(s.oneSample), number(s.multiSample));
+  }
+  out << fmt::format("  {:<26} {:>14} {:>14} {:>14} {:>14}\n", "HDR map only", number(diffuse.hdrOnly()), "",
+                     number(sharp.hdrOnly()), "");
+  out << fmt::format("  {:<26} {:>14} {:>14} {:>14} {:>14}\n", "BRDF only", number(diffuse.brdfOnly()), "",
+                     number(sharp.brdfOnly()), "");
+}
+
 void printComparison(const std::string& id, std::ostream& out) {
   Values ours = reproducedValues(id);
   out << fmt::format("  {:<40} {:<32} {:<32} {}\n", "quantity", "published", "ours", "verdict [source]");
@@ -225,6 +281,7 @@ void printStudy(const Example1D& example, std::ostream& out) {
 }  // namespace
 
 std::map<std::string, std::string> reproducedValues(const std::string& id) {
+  if (id == kFlatlandId) return values001Flatland();
   Example1D example = paperExample(id);  // throws for an unknown id
   if (id == "000-C") return values000C();
   int n = id.back() - '0';
@@ -232,10 +289,17 @@ std::map<std::string, std::string> reproducedValues(const std::string& id) {
 }
 
 void listPaperExamples(std::ostream& out) {
-  for (const std::string& id : paperExampleIds()) out << fmt::format("  {:<6} {}\n", id, paperExample(id).title());
+  for (const std::string& id : paperExampleIds()) out << fmt::format("  {:<7} {}\n", id, paperExample(id).title());
+  out << fmt::format("  {:<7} {}\n", kFlatlandId, kFlatlandTitle);
 }
 
 void printPaperExample(const std::string& id, std::ostream& out) {
+  if (id == kFlatlandId) {
+    out << kFlatlandTitle << "\n\n";
+    printComparison(id, out);
+    printFlatlandTable(out);
+    return;
+  }
   Example1D example = paperExample(id);
   out << example.title() << fmt::format("\n  costs {}\n\n", numbers(example.costs()));
   printComparison(id, out);

@@ -18,6 +18,25 @@ std::string estimatorName(Estimator estimator) {
   return "?";
 }
 
+namespace {
+
+// [Kar19]: the pdf asked for and the one sampled with; a compensated pdf that left no
+// texel positive fell back to plain.
+nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
+  nlohmann::json pdf = {{"requested", envmapPdfName(tables.requestedPdf)},
+                        {"used", envmapPdfName(tables.pdf)},
+                        {"mean_luminance", tables.meanLuminance}};
+  if (tables.requestedPdf.compensated()) {
+    pdf["fallback_to_plain"] = !tables.pdf.compensated();
+    if (!tables.pdf.compensated())
+      pdf["fallback_reason"] = "no texel's luminance exceeds 2(1-C) times the mean (a constant map?)";
+    pdf["zero_texel_fraction"] = tables.zeroTexelFraction;
+  }
+  return pdf;
+}
+
+}  // namespace
+
 nlohmann::json sceneJson(const Scene& scene) {
   const SceneOptions& o = scene.options;
   return {{"envmap", o.envmap},
@@ -29,7 +48,8 @@ nlohmann::json sceneJson(const Scene& scene) {
           {"size", {o.width, o.height}},
           {"view_deg", {o.viewTheta, o.viewPhi}},
           {"techniques", scene.techniqueNames()},
-          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"}};
+          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
+          {"envmap_pdf", envmapPdfJson(scene.tables)}};
 }
 
 nlohmann::json timeSplitJson(double wall, double kernel, double allocation, double host) {

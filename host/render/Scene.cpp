@@ -71,14 +71,23 @@ Scene makeScene(const SceneOptions& options) {
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
-  scene.tables = buildEnvmapTables(scene.envmap, options.sampler);
+  scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   // The tables hold every texel's RGB beside its probability (kernels/envmap.h), so the
-  // input copy goes: 12 of the map's bytes per texel.
-  scene.envmap.image.rgb = std::vector<float>();
+  // input copy goes: 12 of the map's bytes per texel. A compensated pdf keeps it for the
+  // plain tables of the reference and the costs (withPlainEnvmapPdf).
+  if (!options.envmapPdf.compensated()) scene.envmap.image.rgb = std::vector<float>();
   double t = options.viewTheta * M_PI / 180, p = options.viewPhi * M_PI / 180;
   // ω_r = 2(n·ω_o)n − ω_o with n = z.
   scene.mirror = {float(-std::sin(t) * std::cos(p)), float(-std::sin(t) * std::sin(p)), float(std::cos(t))};
   return scene;
+}
+
+Scene withPlainEnvmapPdf(const Scene& scene) {
+  if (!scene.options.envmapPdf.compensated()) return scene;
+  Scene plain = scene;
+  plain.options.envmapPdf = {};
+  plain.tables = buildEnvmapTables(plain.envmap, plain.options.sampler);
+  return plain;
 }
 
 }  // namespace misalloc

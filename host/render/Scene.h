@@ -16,6 +16,7 @@ struct SceneOptions {
   double viewTheta = 0, viewPhi = 0;  // ω_o in degrees; the normal is z
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
   EnvmapSampler sampler = EnvmapSampler::Alias;
+  EnvmapPdf envmapPdf;  // [Kar19]: plain, or compensated for MIS with BRDF sampling
   int proceduralWidth = 512;
 };
 
@@ -35,6 +36,11 @@ struct Scene {
 };
 
 Scene makeScene(const SceneOptions& options);
+
+// The scene with the plain envmap pdf, for the reference: the pdf changes the noise,
+// not the integral, and a reference computed once must not depend on which pdf asked
+// for it first (referenceKey leaves the pdf out).
+Scene withPlainEnvmapPdf(const Scene& scene);
 
 // A shipped map's name ("forest_slope") or a path to an EXR; procedural specs
 // (constant, cosk:K, sun...) are returned unchanged. Throws InputError naming the

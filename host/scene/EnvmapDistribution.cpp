@@ -31,21 +31,27 @@ void requireValidSize(const Envmap& envmap) {
                                             image.width, image.height, image.rgb.size()));
 }
 
+// 0.2126 R + 0.7152 G + 0.0722 B per texel.
+std::vector<double> texelLuminance(const RgbImage& image) {
+  std::vector<double> luminance(std::size_t(image.width) * std::size_t(image.height));
+  for (std::size_t t = 0; t < luminance.size(); ++t) {
+    double r = image.rgb[3 * t], g = image.rgb[3 * t + 1], b = image.rgb[3 * t + 2];
+    if (!(r >= 0 && g >= 0 && b >= 0) || !std::isfinite(r + g + b))
+      throw std::invalid_argument(
+          fmt::format("envmap texel ({}, {}) is negative or not finite", t % image.width, t / image.width));
+    luminance[t] = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+  }
+  return luminance;
+}
+
 // Luminance × sin θ at the texel centre: p(ω) = P W H / (2π² sin θ) inside a texel,
 // so this makes the solid-angle pdf ∝ luminance up to the variation of sin θ across it.
-std::vector<double> luminanceWeights(const RgbImage& image) {
-  std::vector<double> weights(std::size_t(image.width) * std::size_t(image.height));
-  for (int row = 0; row < image.height; ++row) {
-    double sinTheta = sinThetaOfRow(row, image.height);
-    for (int col = 0; col < image.width; ++col) {
-      std::size_t t = std::size_t(row) * std::size_t(image.width) + std::size_t(col);
-      double r = image.rgb[3 * t], g = image.rgb[3 * t + 1], b = image.rgb[3 * t + 2];
-      if (!(r >= 0 && g >= 0 && b >= 0) || !std::isfinite(r + g + b))
-        throw std::invalid_argument(fmt::format("envmap texel ({}, {}) is negative or not finite", col, row));
-      weights[t] = (0.2126 * r + 0.7152 * g + 0.0722 * b) * sinTheta;
-    }
+std::vector<double> sinThetaWeighted(std::vector<double> luminance, int width, int height) {
+  for (int row = 0; row < height; ++row) {
+    double sinTheta = sinThetaOfRow(row, height);
+    for (int col = 0; col < width; ++col) luminance[std::size_t(row) * std::size_t(width) + col] *= sinTheta;
   }
-  return weights;
+  return luminance;
 }
 
 // sin θ alone: uniform over the sphere.
@@ -123,14 +129,31 @@ int binarySearchSteps(int n) {
 
 }  // namespace
 
-EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler) {
+EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf) {
   requireValidSize(envmap);
   const RgbImage& image = envmap.image;
   EnvmapTables tables;
   tables.width = image.width;
   tables.height = image.height;
+  tables.requestedPdf = pdf;
 
-  std::vector<double> weights = luminanceWeights(image);
+  const std::vector<double> luminance = texelLuminance(image);
+  tables.meanLuminance = solidAngleMeanLuminance(luminance, image.width, image.height);
+  std::vector<double> weights;
+  if (pdf.compensated()) {
+    std::vector<double> compensated(luminance.size());
+    std::size_t zeros = 0;
+    for (std::size_t t = 0; t < luminance.size(); ++t) {
+      compensated[t] = compensatedLuminance(luminance[t], tables.meanLuminance, pdf.envmapFraction);
+      zeros += compensated[t] > 0 ? 0 : 1;
+    }
+    if (zeros < luminance.size()) {
+      weights = sinThetaWeighted(std::move(compensated), image.width, image.height);
+      tables.pdf = pdf;
+      tables.zeroTexelFraction = double(zeros) / double(luminance.size());
+    }
+  }
+  if (weights.empty()) weights = sinThetaWeighted(luminance, image.width, image.height);
   double total = 0;
   for (double w : weights) total += w;
   tables.uniformFallback = !(total > 0);

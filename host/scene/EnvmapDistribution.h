@@ -1,10 +1,12 @@
 #pragma once
 // The envmap's sampling distribution, laid out as kernels/envmap.h reads it: texel
-// probabilities ∝ luminance × sin θ, and either an alias table or marginal and
-// conditional CDFs that draw texels with those probabilities.
+// probabilities ∝ luminance × sin θ (or its MIS-compensated form, [Kar19] eq. 14, ×
+// sin θ), and either an alias table or marginal and conditional CDFs that draw texels
+// with those probabilities.
 #include <cstdint>
 #include <vector>
 
+#include "scene/CompensatedPdf.h"
 #include "scene/Envmap.h"
 
 namespace misalloc {
@@ -28,17 +30,23 @@ struct EnvmapTables {
   // The map is black, so the texels are drawn ∝ sin θ instead: uniform over the
   // sphere. The radiance stays 0; callers should say so.
   bool uniformFallback = false;
+  // The pdf asked for, and the one the tables hold: a compensated pdf that leaves no
+  // texel positive (a constant map with C ≤ 0.5) falls back to plain; callers should
+  // say so. Plain also on uniformFallback.
+  EnvmapPdf requestedPdf, pdf;
+  double meanLuminance = 0;      // L̄ of [Kar19] eq. 14 (solidAngleMeanLuminance)
+  double zeroTexelFraction = 0;  // compensated: the texels it never draws (L ≤ 2(1−C)·L̄)
 };
 
-// Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B times sin θ at the
-// texel's centre, so that the solid-angle pdf is ∝ luminance. Probabilities and
-// prefix sums are computed in double and stored as float; a texel of weight 0 is never
+// Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B (compensated with
+// `pdf`) times sin θ at the texel's centre, so that the solid-angle pdf is ∝ luminance
+// (compensated). Probabilities and prefix sums are computed in double and stored as float; a texel of weight 0 is never
 // drawn by either sampler. The alias sampler stores the weights' probabilities. The
 // CDF sampler stores the probabilities its float CDFs realise with the kernel's 24-bit
 // uniforms: they differ from the weights' by up to ~2^-24 (W+H) in total, and an
 // estimate that divides by the stored pdf stays exactly unbiased. The texels must be finite and ≥ 0, as readExr and
 // makeEnvmap make them (else std::invalid_argument). Throws InputError, naming the
 // map, if it has too many texels for the kernels' 32-bit int indexing.
-EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler);
+EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf = {});
 
 }  // namespace misalloc

@@ -1,0 +1,264 @@
+// The MIS-compensated envmap pdf ([Kar19] eq. 14): its tables, its fallback on a
+// constant map, the refusal of envmap sampling alone, and the unbiasedness of every
+// method with it against the closed form 000 eq. 6.17. The pdf ∝ max(0, L − 2(1−C)·L̄)
+// is zero on most of a cos^K map, so these estimates rest on BRDF sampling there.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "CliRunner.h"
+#include "Error.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "compare/EnvmapPdfComparison.h"
+#include "render/BrdfCoverage.h"
+#include "render/Reference.h"
+#include "render/Render.h"
+#include "render/Report.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+Scene compensatedScene(const std::string& envmap, const std::string& grid, const std::string& pdf,
+                       EnvmapSampler sampler = EnvmapSampler::Alias, bool split = false, int size = 32) {
+  SceneOptions o;
+  o.envmap = envmap;
+  o.grid = grid;
+  o.width = o.height = size;
+  o.splitBrdf = split;
+  o.sampler = sampler;
+  o.envmapPdf = parseEnvmapPdf(pdf);
+  o.proceduralWidth = 128;
+  return makeScene(o);
+}
+
+double luminanceOfTexel(const EnvmapTables& tables, size_t t) {
+  return 0.2126 * tables.texels[4 * t] + 0.7152 * tables.texels[4 * t + 1] + 0.0722 * tables.texels[4 * t + 2];
+}
+
+Rendering renderWith(const Scene& scene, Method method, Estimator estimator, int spp, uint64_t seed) {
+  AdaptiveOptions options;
+  options.costs.assign(scene.techniqueCount(), 1.0);
+  options.oracleSamples = 128;
+  requireBrdfCoverage(scene.options.envmapPdf, scene.techniqueCount(), method, estimator, spp, options);
+  Sampler sampler(testDevice(), scene, samplerConfigFor(method, estimator, spp, options));
+  return render(sampler, method, options, spp, seed);
+}
+
+}  // namespace
+
+TEST_CASE("--envmap-pdf parses plain, compensated and compensated:C", "[compensated]") {
+  CHECK_FALSE(parseEnvmapPdf("plain").compensated());
+  CHECK(parseEnvmapPdf("compensated").compensated());
+  CHECK(parseEnvmapPdf("compensated").envmapFraction == 0.5);
+  CHECK(parseEnvmapPdf("compensated:0.25").envmapFraction == 0.25);
+  CHECK(parseEnvmapPdf("compensated:1").envmapFraction == 1);
+  CHECK(envmapPdfName(parseEnvmapPdf("compensated")) == "compensated:0.5");
+  CHECK(envmapPdfName(parseEnvmapPdf("plain")) == "plain");
+  for (const char* bad :
+       {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:", "optimal", "Plain"})
+    CHECK_THROWS_AS(parseEnvmapPdf(bad), InputError);
+}
+
+TEST_CASE("L̄ of a cos^K map is 1/(2(K+1)) and the compensated pdf drops every texel at or below it", "[compensated]") {
+  for (double K : {0.5, 1.0, 3.0, 20.0})
+    for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      Scene scene = compensatedScene(fmt::format("cosk:{}", K), "uniform:0.5,0.5,5", "compensated", sampler, false, 2);
+      const EnvmapTables& t = scene.tables;
+      INFO(fmt::format("K {} cdf {}", K, t.useCdf));
+      // The rasteriser's texel averages take the midpoint rule over 16 sub-rows.
+      CHECK(t.meanLuminance == Approx(1 / (2 * (K + 1))).epsilon(1e-4));
+      REQUIRE(t.pdf.compensated());
+      const double threshold = 2 * (1 - 0.5) * t.meanLuminance;
+      double sum = 0, zeros = 0;
+      size_t wrong = 0;
+      for (size_t i = 0; i < t.texels.size() / 4; ++i) {
+        const double p = t.texels[4 * i + 3];
+        sum += p;
+        zeros += p == 0;
+        // Rows whose luminance is within float rounding of L̄ may go either way.
+        if (std::abs(luminanceOfTexel(t, i) - threshold) > 1e-5 * threshold)
+          wrong += (luminanceOfTexel(t, i) > threshold) != (p > 0);
+      }
+      CHECK(wrong == 0);
+      CHECK(sum == Approx(1).epsilon(1e-5));
+      CHECK(zeros / double(t.texels.size() / 4) == Approx(t.zeroTexelFraction).margin(1e-3));
+    }
+}
+
+TEST_CASE("the alias table stores probabilities ∝ (L − 2(1−C)·L̄) sin θ", "[compensated]") {
+  for (double C : {0.5, 0.25, 0.9}) {
+    Scene scene = compensatedScene("sun:30,40,5,100", "uniform:0.5,0.5,5", fmt::format("compensated:{}", C),
+                                   EnvmapSampler::Alias, false, 2);
+    const EnvmapTables& t = scene.tables;
+    std::vector<double> w(t.texels.size() / 4);
+    double total = 0;
+    for (size_t i = 0; i < w.size(); ++i) {
+      const double sinTheta = std::sin(M_PI * (double(i / t.width) + 0.5) / t.height);
+      w[i] = std::max(0.0, luminanceOfTexel(t, i) - 2 * (1 - C) * t.meanLuminance) * sinTheta;
+      total += w[i];
+    }
+    double error = 0;
+    for (size_t i = 0; i < w.size(); ++i) error += std::abs(w[i] / total - t.texels[4 * i + 3]);
+    INFO("C " << C);
+    CHECK(error < 1e-5);
+  }
+}
+
+TEST_CASE("a compensated pdf that leaves no texel falls back to plain, and the report says so", "[compensated]") {
+  for (const char* pdf : {"compensated", "compensated:0.3"}) {
+    Scene scene = compensatedScene("constant:2", "uniform:0.5,0.5,5", pdf, EnvmapSampler::Cdf, false, 2);
+    INFO(pdf);
+    CHECK(scene.tables.requestedPdf.compensated());
+    CHECK_FALSE(scene.tables.pdf.compensated());
+    CHECK_FALSE(scene.tables.uniformFallback);
+    nlohmann::json j = sceneJson(scene)["envmap_pdf"];
+    CHECK(j["requested"] == envmapPdfName(parseEnvmapPdf(pdf)));
+    CHECK(j["used"] == "plain");
+    CHECK(j["fallback_to_plain"] == true);
+    CHECK(j["mean_luminance"].get<double>() == Approx(2).epsilon(1e-6));
+  }
+  // C > 1/2 subtracts less than the constant: every texel stays, so no fallback.
+  Scene kept = compensatedScene("constant:2", "uniform:0.5,0.5,5", "compensated:0.75", EnvmapSampler::Alias, false, 2);
+  CHECK(kept.tables.pdf.compensated());
+  CHECK(kept.tables.zeroTexelFraction == 0);
+  CHECK(sceneJson(kept)["envmap_pdf"]["fallback_to_plain"] == false);
+  // The reference's scene is plain whatever the render's pdf.
+  Scene sun = compensatedScene("sun", "uniform:0.5,0.5,5", "compensated", EnvmapSampler::Alias, false, 2);
+  CHECK(sun.tables.pdf.compensated());
+  CHECK_FALSE(withPlainEnvmapPdf(sun).tables.pdf.compensated());
+  CHECK(referenceKey(withPlainEnvmapPdf(sun), 64) == referenceKey(sun, 64));
+}
+
+TEST_CASE("the compensated pdf refuses schedules that could skip BRDF sampling", "[compensated][bad-input]") {
+  const EnvmapPdf plain, compensated = parseEnvmapPdf("compensated");
+  AdaptiveOptions options;
+  CHECK_THROWS_WITH(requireBrdfCoverage(compensated, 2, Method::Envmap, Estimator::MultiSample, 64, options),
+                    Catch::Contains("--method envmap with --envmap-pdf compensated:0.5"));
+  CHECK_NOTHROW(requireBrdfCoverage(plain, 2, Method::Envmap, Estimator::MultiSample, 64, options));
+  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Brdf, Estimator::MultiSample, 1, options));
+  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Equal, Estimator::OneSample, 1, options));
+  CHECK_THROWS_AS(requireBrdfCoverage(compensated, 2, Method::Equal, Estimator::MultiSample, 1, options), InputError);
+  CHECK_THROWS_AS(requireBrdfCoverage(compensated, 3, Method::Oracle, Estimator::MultiSample, 2, options), InputError);
+  // 9 spp: a pilot of 4, then stages of 2, 1, 1, 1: the floor cannot give both techniques one.
+  CHECK_THROWS_WITH(requireBrdfCoverage(compensated, 2, Method::Heuristic, Estimator::MultiSample, 9, options),
+                    Catch::Contains("a stage of 1 sample(s)"));
+  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Heuristic, Estimator::MultiSample, 12, options));
+
+  TempDir dir("compensated");
+  const std::string outputs = fmt::format("--out {} --report {} --reference none", (dir.path / "r.exr").string(),
+                                          (dir.path / "r.json").string());
+  auto r = runMisalloc(fmt::format("render --size 8x8 --spp 4 --method envmap --envmap-pdf compensated {}", outputs));
+  INFO(r.output);
+  CHECK(r.exitCode == 2);
+  CHECK(r.output.find("--method envmap with --envmap-pdf compensated:0.5") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "r.exr"));
+  auto bad = runMisalloc(fmt::format("render --size 8x8 --spp 4 --envmap-pdf compensated:2 {}", outputs));
+  CHECK(bad.exitCode == 2);
+  CHECK(bad.output.find("must lie in (0, 1]") != std::string::npos);
+}
+
+TEST_CASE("every method is unbiased with the compensated pdf against 000 eq. 6.17", "[compensated][unbiased]") {
+  struct Case {
+    double rhoD, n, K;
+    const char* pdf;
+  };
+  const Case cases[] = {{0.5, 5, 1, "compensated"}, {0.2, 50, 3, "compensated:0.25"}, {0.9, 20, 0.5, "compensated"}};
+  const std::vector<std::pair<Method, Estimator>> methods = {
+      {Method::Brdf, Estimator::MultiSample},       {Method::Equal, Estimator::MultiSample},
+      {Method::Equal, Estimator::OneSample},        {Method::Heuristic, Estimator::MultiSample},
+      {Method::SigmaSqrtC, Estimator::MultiSample}, {Method::Linear, Estimator::MultiSample},
+      {Method::Exact, Estimator::MultiSample},      {Method::Oracle, Estimator::MultiSample}};
+  uint64_t seed = 900;
+  for (const Case& c : cases) {
+    const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+    for (bool split : {false, true})
+      for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+        Scene scene = compensatedScene(fmt::format("cosk:{}", c.K),
+                                       fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), c.pdf, s, split);
+        REQUIRE(scene.tables.pdf.compensated());
+        for (auto [m, e] : methods) {
+          Rendering r = renderWith(scene, m, e, 60, ++seed);
+          MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
+          double z = zScore(mean.mean, expected, mean.standardError);
+          INFO(fmt::format("rhoD {} n {} K {} {} split {} cdf {} {} one-sample {}: mean {} expected {} z {}", c.rhoD,
+                           c.n, c.K, c.pdf, split, s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample,
+                           mean.mean, expected, z));
+          CHECK(std::abs(z) < kMaxZ);
+        }
+      }
+  }
+}
+
+TEST_CASE("compare runs each scene with each envmap pdf and compares them with equal and plain",
+          "[compensated][compare]") {
+  auto runRecord = [](const std::string& label, Method m, int budget, int repeat, double seconds, double mse) {
+    RunRecord r;
+    r.caseLabel = label;
+    r.method = m;
+    r.budget = budget;
+    r.repeat = repeat;
+    r.wallSeconds = r.kernelSeconds = seconds;
+    r.mse = mse;
+    r.meanAlpha = {0.5, 0.5};
+    return r;
+  };
+  // Two pdfs of one scene: the compensated one halves equal's MSE at the same times, so
+  // under the Monte Carlo law MSE ∝ 1/t plain equal needs twice as long.
+  Comparison c;
+  for (const char* pdf : {"plain", "compensated:0.5"}) {
+    nlohmann::json scene = {{"envmap", "m"}, {"envmap_pdf", {{"requested", pdf}}}};
+    const std::string label = std::string("m-") + pdf;
+    c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
+    for (int budget : {10, 20})
+      c.runs.push_back(runRecord(label, Method::Equal, budget, 0, 0.01 * budget,
+                                 (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));
+  }
+  CompareOptions o;
+  o.methods = {Method::Equal};
+  o.budgets = {10, 20};
+  o.repeats = 1;
+  o.tableBudget = 20;
+  Summary s = summarize(c, o);
+  TextTable t = envmapPdfSpeedUpTable(s, 20);
+  REQUIRE(t.rows.size() == 2);
+  CHECK(t.header == std::vector<std::string>{"method", "pdf", "m-plain", "geometric mean"});
+  CHECK(t.rows[0][1].text == "plain");
+  CHECK(t.rows[0][2].text == "1.00");
+  CHECK(t.rows[1][1].text == "compensated:0.5");
+  CHECK(t.rows[1][2].text == "~2.00");  // below plain's least error: read past its curve's end
+  CHECK(envmapPdfMarkdown(s).find("speed-up over equal with the plain pdf") != std::string::npos);
+
+  CHECK(parseEnvmapPdfList("plain,compensated:0.25").size() == 2);
+  CHECK_THROWS_WITH(parseEnvmapPdfList("compensated,compensated:0.5"), Catch::Contains("listed twice"));
+  std::vector<CompareCase> cases = casesPerEnvmapPdf({{"x", SceneOptions{}}}, parseEnvmapPdfList("plain,compensated"));
+  REQUIRE(cases.size() == 2);
+  CHECK(cases[0].label == "forest_slope");
+  CHECK(cases[1].label == "forest_slope-comp0.5");
+
+  TempDir dir("compare_pdfs");
+  const auto out = dir.path / "out";
+  auto r =
+      runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 --methods equal,brdf "
+                              "--envmap-pdfs plain,compensated --device cpu --out-dir {} --cache-dir {}",
+                              out.string(), (dir.path / "cache").string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  CHECK(std::filesystem::exists(out / "envmap_pdfs.md"));
+  CHECK(std::filesystem::exists(out / "cosk_2-comp0.5/equal_20spp.exr"));
+  nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
+  CHECK(runs["runs"].size() == 2 * 2 * 2 * 2);
+  CHECK(runs["cases"][1]["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
+  CHECK(runs["cases"][1]["reference"] == "analytic (000 eq. 6.17)");
+
+  auto refused = runMisalloc(fmt::format(
+      "compare --envmap cosk:2 --size 8x8 --budgets 10 --envmap-pdfs plain,compensated --out-dir {}", out.string()));
+  CHECK(refused.exitCode == 2);
+  CHECK(refused.output.find("--method envmap with --envmap-pdf compensated:0.5") != std::string::npos);
+}
