@@ -10,6 +10,7 @@
 #include <memory>
 #include <sstream>
 
+#include "AtomicFile.h"
 #include "Error.h"
 #include "JsonText.h"
 #include "MemoryBudget.h"
@@ -261,7 +262,7 @@ int main(int argc, char** argv) {
   renderScene.addEnvmapPdf(renderCmd);
   int spp = 200, localSize = 8, referenceSpp = 16384;
   uint64_t seed = 1;
-  std::string method = "equal", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
+  std::string method = "exact", estimatorName = "multi", deviceSpec = "auto", out = "render.exr",
               reportPath = "render.json", referenceMode = "auto", cacheDir = defaultCacheDir();
   renderCmd->add_option("--spp", spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
   renderCmd->add_option("--method", method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
