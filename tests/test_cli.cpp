@@ -36,7 +36,7 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   REQUIRE(r.exitCode == 0);
   REQUIRE(fs::exists(out));
   nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
-  CHECK(j["method"] == "equal");
+  CHECK(j["method"] == "exact");
   CHECK(j["spp"] == 8);
   CHECK(j["reference"]["source"] == "analytic (000 eq. 6.17)");
   CHECK(j["rmse_x1000"].get<double>() > 0);
@@ -75,7 +75,7 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--envmap cosk:x", "cosk:x"},
   };
   for (const Case& c : cases) {
-    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 4 {} {}", outputs, c.args));
+    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 {} {}", outputs, c.args));
     INFO(c.args << "\n" << r.output);
     CHECK(r.exitCode != 0);
     CHECK(r.output.find(c.expected) != std::string::npos);
@@ -122,7 +122,7 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
                         {"nan.exr", "1 NaN or infinite channel values, the first at x=2, y=1, channel R"}};
   auto out = dir.path / "r.exr", report = dir.path / "r.json";
   for (const Case& c : cases) {
-    auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 4 --reference none --out {} --report {}",
+    auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 8 --reference none --out {} --report {}",
                                      file(c.name), out.string(), report.string()));
     INFO(c.name << "\n" << r.output);
     CHECK(r.exitCode == 2);
@@ -141,7 +141,7 @@ TEST_CASE("negative texels are set to 0 with a warning and a count", "[cli][bad-
   const std::string map = (dir.path / "neg.exr").string();
   misalloc::writeExr(map, image);
   auto report = dir.path / "r.json";
-  auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 4 --reference none --out {} --report {}", map,
+  auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 8 --reference none --out {} --report {}", map,
                                    (dir.path / "r.exr").string(), report.string()));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
