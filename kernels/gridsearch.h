@@ -1,4 +1,4 @@
-// Paper 000's Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
+// [HS14]'s Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
 // kernel (kernels/gridsearch.cl) and its C++ reference (host/alloc/GridSearch.cpp)
 // share, so that both compute bit for bit the same sums and rank the weight
 // combinations with the same code. Only the loop over samples × combinations is each
@@ -7,22 +7,16 @@
 // The sums over a pixel's samples are running sums: the grid α_l is fixed and a
 // sample's g = f/p_α never changes, so each search adds only the samples taken since
 // the previous one, and the pixel's summary (PixelSummary) carries over with them.
+#include "namespace_check.h"
 #ifndef MA_GRIDSEARCH_H
 #define MA_GRIDSEARCH_H
+#include "fallbacks.h"
 #include "fastmath.h"
 
-#define MA_GRID_MAX_TECHNIQUES 4
-
-// Which weight combination Algorithm 1 keeps (000 Alg. 1 line 13).
+// Which weight combination Algorithm 1 keeps ([HS14] Alg. 1 line 13).
 #define MA_RULE_MAX_ENTROPY 0        // as written: λ_{j,l} closest to uniform by entropy
 #define MA_RULE_MIN_COST_VARIANCE 1  // least cost × variance of the multi-sample estimator
 
-// The bits of host/alloc/Allocation.h's AllocationFallback (static_assert there).
-#define MA_FALLBACK_NON_FINITE 1u
-#define MA_FALLBACK_TOO_FEW_SAMPLES 2u
-#define MA_FALLBACK_NO_SIGNAL 4u
-#define MA_FALLBACK_SILENT_TECHNIQUE 8u
-#define MA_FALLBACK_SINGULAR_SYSTEM 64u
 
 // Value q of a pixel's sample i, with `pixelSamples` at the pixel's first value: the
 // layout of kernels/stats.h (storedSampleIndex), records of M + 2 rows of 16 pixels.
@@ -189,11 +183,11 @@ MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount
   } while (0)
 
 // Rule (b): −(Σ_k c_k α_k) V, with V the variance of the multi-sample balance heuristic
-// for N = 1 (002 eq. 21 and Table 2; ../shared/papers/README.md, "Multi-sample"), the
+// for N = 1 ([SHS16] eq. 21 and Table 2; docs/papers.md), the
 // estimator the renderer runs with the selected α: V = ∫ f²/p_α − Σ_j μ'_j²/α_j with
 // μ'_j = ∫ α_j p_j f / p_α = α_j μ_j, and ∫ f²/p_α = Σ_j α_j ν_j, so V = Σ_j α_j (ν_j − μ_j²),
 // μ_j = E_j[g] and ν_j = E_j[g²] under technique j's pdf, g = f/p_α. They are estimated
-// from technique j's m_j samples by 000 eq. 6.6 and 6.8. Cancellation can leave a
+// from technique j's m_j samples by [HS14] eq. 6.6 and 6.8. Cancellation can leave a
 // tiny negative ν_j − μ_j², which is 0.
 // Defined for T = float and, in the kernel, T = float16 (16 combinations at once):
 // OpenCL C has no overloading, and the builtins in the body take either.
@@ -211,8 +205,8 @@ MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore, float)
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore16, float16)
 #endif
 
-// Rule (a), 000 Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
-// V = Σ_j α_j ν_j − μ² (000 eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j (000 eq. 4.16)
+// Rule (a), [HS14] Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
+// V = Σ_j α_j ν_j − μ² ([HS14] eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j ([HS14] eq. 4.16)
 // is the same for every j at the optimum. Score: the entropy of λ_j = Λ_j / Σ_j Λ_j.
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.

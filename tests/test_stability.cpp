@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "Constants.h"
 #include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -178,7 +179,7 @@ TEST_CASE("the Phong lobe and its sampler keep float precision up to n = 1e5", "
 }
 
 TEST_CASE("near-mirror Phong lobes n = 1e3, 1e4, 1e5 with rhoS = 1 are unbiased", "[stability]") {
-  // View along the normal: 000 eq. 6.17 is exact. Envmap-only sampling of a lobe of
+  // View along the normal: [HS14] eq. 6.17 is exact. Envmap-only sampling of a lobe of
   // solid angle ~2π/n is too heavy-tailed for a z-test, so it is left out.
   uint64_t seed = 1000;
   for (double n : {1e3, 1e4, 1e5}) {
@@ -313,7 +314,7 @@ TEST_CASE("a map black on the upper hemisphere: the true value 0 is estimated as
 
 TEST_CASE("1x1 and 2x1 maps: unbiased against the constant's closed form", "[stability]") {
   // Normal view: the lobes are symmetric in φ, so the value is the mean radiance ×
-  // (ρd + ρs) (000 eq. 6.17 with K = 0 on the sphere's upper half).
+  // (ρd + ρs) ([HS14] eq. 6.17 with K = 0 on the sphere's upper half).
   std::string one = writeMap("1x1", 1, 1, {2, 2, 2});
   std::string two = writeMap("2x1", 2, 1, {1, 1, 1, 3, 3, 3});
   uint64_t seed = 9000;
@@ -377,7 +378,7 @@ TEST_CASE("a 16384x8192 map: tables sum to 1 in double and sampling stays unbias
 // Allocations
 // ---------------------------------------------------------------------------------
 
-TEST_CASE("003 example 6: the optimum on the simplex boundary, alpha_1 = 0", "[stability]") {
+TEST_CASE("[SS23] example 6: the optimum on the simplex boundary, alpha_1 = 0", "[stability]") {
   Example1D example = paperExample("003-6");
   OptimalMixture best = minimiseInefficiency(example, VarianceModel::MultiSample,
                                              std::vector<double>(example.costs().size(), 1.0));
@@ -395,7 +396,7 @@ TEST_CASE("003 example 6: the optimum on the simplex boundary, alpha_1 = 0", "[s
   }
 }
 
-TEST_CASE("zero-variance mixtures (003 example 2, 002 example 4) without 0/0", "[stability]") {
+TEST_CASE("zero-variance mixtures ([SS23] example 2, [SHS16] example 4) without 0/0", "[stability]") {
   for (const char* id : {"003-2", "002-4"}) {
     Example1D example = paperExample(id);
     StudyConfig config;
@@ -414,7 +415,7 @@ TEST_CASE("zero-variance mixtures (003 example 2, 002 example 4) without 0/0", "
       // double round-off of that difference (~1e-16 λ), never a real negative number.
       CHECK(o.inefficiency.mean >= -1e-12 * scale);
       if (o.rule == AllocationRule::LinearDropMostNegative || o.rule == AllocationRule::LinearMinSampleVariance)
-        CHECK(std::abs(o.inefficiency.mean) <= 1e-12 * scale);  // 003: the linear heuristic finds the mixture
+        CHECK(std::abs(o.inefficiency.mean) <= 1e-12 * scale);  // [SS23]: the linear heuristic finds the mixture
     }
   }
 }
@@ -497,7 +498,7 @@ TEST_CASE("1e7 samples per pixel: the accumulated estimate keeps double precisio
   const double expected = closedForm(0.5, 0.5, 5, 1);
   Rendering r = renderWith(scene, Method::Equal, 10000000, 14000, {}, 1);
   CHECK(badValues(r, 2) == 0);
-  double y = 0.2126 * r.image.rgb[0] + 0.7152 * r.image.rgb[1] + 0.0722 * r.image.rgb[2];
+  double y = luminance(r.image.rgb[0], r.image.rgb[1], r.image.rgb[2]);
   double z = zScore(y, expected, std::sqrt(r.variance[0]));
   INFO(fmt::format("estimate {} expected {} sd {} z {}", y, expected, std::sqrt(r.variance[0]), z));
   CHECK(std::abs(z) < kMaxZ);

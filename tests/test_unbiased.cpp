@@ -1,4 +1,4 @@
-// Every estimator is unbiased: against the closed form 000 eq. 6.17 (envmap cos^K θ,
+// Every estimator is unbiased: against the closed form [HS14] eq. 6.17 (envmap cos^K θ,
 // view along the normal) and, where there is none, against each other. Each pixel of a
 // uniform grid is an independent estimate of the same value, so the pixel mean has a
 // known standard error; fixed seeds make every z-score reproducible.
@@ -23,7 +23,7 @@ MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, 
 
 }  // namespace
 
-TEST_CASE("every estimator is unbiased against 000 eq. 6.17", "[unbiased]") {
+TEST_CASE("every estimator is unbiased against [HS14] eq. 6.17", "[unbiased]") {
   struct Case {
     double rhoD, n, K;
   };
