@@ -1,4 +1,4 @@
-// Throughput of the exact allocation's grid search (000 Algorithm 1) in evaluations
+// Throughput of the exact allocation's grid search ([HS14] Algorithm 1) in evaluations
 // per second (pixels × U × samples): kernels/gridsearch.cl on an OpenCL device (PoCL by
 // default) side by side, in one run, with its OpenMP C++ peer (GridSearchReference,
 // compiled by g++ -O3 -march=native), for both selection rules. One repetition runs the
@@ -19,6 +19,7 @@
 #include <iostream>
 #include <random>
 
+#include "Constants.h"
 #include "KernelCode.h"
 #include "PeerComparison.h"
 #include "alloc/GridSearch.h"
@@ -63,7 +64,7 @@ const std::vector<std::vector<float>>& benchStages() {
     for (int b = 0; b < stageCount(); ++b) s.emplace_back(stageLayout(b).floatCount(), 1.0f);
     std::mt19937_64 rng(1);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    for (int pixel = 0; pixel < (pixelCount() + 15) / 16 * 16; ++pixel) {
+    for (int pixel = 0; pixel < int(misalloc::paddedPixelCount(pixelCount())); ++pixel) {
       double exponent = 0.5 + 2 * uniform(rng), offset = 0.05 + 0.5 * uniform(rng), mix = 0.2 + 0.6 * uniform(rng);
       int firstCount = int(mix * config.stage);
       for (int i = 0; i < config.samples; ++i) {

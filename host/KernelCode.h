@@ -8,8 +8,11 @@
 #include <cstdint>
 #include <cstring>
 
+// Every kernel header checks that it is included inside this namespace
+// (kernels/namespace_check.h).
 namespace misalloc::kern {
 #include "estimator.h"
+#include "fallbacks.h"
 #include "pixel.h"
 #include "stats.h"
 }  // namespace misalloc::kern

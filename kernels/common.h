@@ -1,11 +1,13 @@
 // Shared between OpenCL C 1.2 kernels and their C++ host references: the same
 // functions compile as both, so a host reference runs exactly the kernel's maths.
 // In C++ the includer provides <cmath>, <cstdint> and Random123 before this file.
+
+#include "namespace_check.h"
 #ifndef MA_COMMON_H
 #define MA_COMMON_H
 
 // Every shared function is forced inline: one call left in the sample loop keeps
-// PoCL from vectorising across work-items (../shared/notes/pocl-performance.md, rule 1).
+// PoCL from vectorising across work-items (docs/pocl.md, rule 1).
 #ifdef __OPENCL_VERSION__
 #define MA_FN static inline __attribute__((always_inline))
 #define MA_GLOBAL __global
@@ -30,27 +32,41 @@ typedef float ma_acc;
 #else
 #define MA_FN static inline __attribute__((always_inline))
 #define MA_GLOBAL
-#define ma_sqrt(x) std::sqrt(x)
-#define ma_floor(x) std::floor(x)
-#define ma_fma(a, b, c) std::fma(a, b, c)
-// Plain comparisons: std::fmin and std::fmax are library calls that honour NaNs.
-#define ma_min(a, b) ((a) < (b) ? (a) : (b))
-#define ma_max(a, b) ((a) > (b) ? (a) : (b))
-#define ma_abs(x) std::fabs(x)
 typedef uint32_t ma_uint;
 typedef uint64_t ma_ulong;
 #define MA_UNROLL
 typedef double ma_acc;
-static inline float ma_as_float(ma_uint u) {
+// The OpenCL builtins as functions of float, as the kernels call them: each argument is
+// evaluated once, and nothing leaks out of namespace misalloc::kern.
+MA_FN float ma_sqrt(float x) { return std::sqrt(x); }
+MA_FN float ma_floor(float x) { return std::floor(x); }
+MA_FN float ma_fma(float a, float b, float c) { return std::fma(a, b, c); }
+MA_FN float ma_abs(float x) { return std::fabs(x); }
+// OpenCL's fmin and fmax: a NaN argument loses to a number. Written as comparisons,
+// which inline, where std::fmin and std::fmax are library calls; equal arguments give b.
+MA_FN float ma_min(float a, float b) { return (a < b || b != b) ? a : b; }
+MA_FN float ma_max(float a, float b) { return (a > b || b != b) ? a : b; }
+MA_FN float ma_as_float(ma_uint u) {
   float f;
   std::memcpy(&f, &u, 4);
   return f;
 }
-static inline ma_uint ma_as_uint(float f) {
+MA_FN ma_uint ma_as_uint(float f) {
   ma_uint u;
   std::memcpy(&u, &f, 4);
   return u;
 }
+#endif
+
+// The most techniques the kernels handle, one place for both. The sampling kernel
+// draws from at most 3: the envmap and the BRDF, or the envmap and the BRDF's two lobes
+// (--split-brdf); its per-sample arrays have this size. The statistics and the grid
+// search take up to 4 (the papers' 1D examples have up to 4 techniques); host code
+// calls that kMaxTechniques (host/alloc/PixelStats.h).
+#define MA_MAX_TECHNIQUES 3
+#define MA_GRID_MAX_TECHNIQUES 4
+#if MA_MAX_TECHNIQUES > MA_GRID_MAX_TECHNIQUES
+#error "the statistics must hold every technique the sampler draws from"
 #endif
 
 #define MA_PI 3.14159265358979323846f
@@ -76,7 +92,8 @@ MA_FN float dot3(MaVec3 a, MaVec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z;
 
 MA_FN MaVec3 scale3(MaVec3 a, float s) { return makeVec3(a.x * s, a.y * s, a.z * s); }
 
-// Rec.709 luminance, as in ../shared/data/envmaps/README.md.
+// Rec. 709 luminance, the maps' colour space (data/envmaps/README.md). Host code in
+// double: misalloc::luminance (host/Constants.h), the same weights.
 MA_FN float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 #endif

@@ -1,6 +1,8 @@
 // Techniques of the envmap × BRDF estimator and one sample of the balance-heuristic
-// MIS estimator (000 eq. 4.1–4.3). Host side: host/render/Technique.h and
-// host/render/HostSampler.cpp (the C++ reference of kernels/sample.cl).
+// MIS estimator ([HS14] eq. 4.1–4.3). Host side: host/render/Scene.h (techniqueCount,
+// techniqueNames: the techniques in this order), host/render/Sampler.h (the driver of
+// kernels/sample.cl) and host/render/HostSampler.cpp (its C++ reference).
+#include "namespace_check.h"
 #ifndef MA_ESTIMATOR_H
 #define MA_ESTIMATOR_H
 #include "common.h"
@@ -8,7 +10,6 @@
 #include "phong.h"
 #include "rng.h"
 
-#define MA_MAX_TECHNIQUES 3
 // Technique 0 samples the envmap. With the BRDF as one technique, 1 samples BRDF×cos
 // (the mixture of both lobes); split into lobes, 1 is the cosine lobe, 2 the Phong lobe.
 #define MA_TECHNIQUE_ENVMAP 0
@@ -48,7 +49,7 @@ MA_FN void techniquePdfs(TechniqueSet ts, PhongParams b, MaVec3 wi, float envmap
   pdfs[2] = ts.splitBrdf ? specularPdf(b, lobe) : 0.0f;
 }
 
-// 000 eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
+// [HS14] eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
 MA_FN float mixturePdf(int techniqueCount, const float* alpha, const float* pdfs) {
   float p = 0.0f;
   MA_UNROLL

@@ -1,7 +1,8 @@
 // Inlinable float approximations of log2, exp2, pow, log1p, expm1, sin/cos, acos and atan2.
 // OpenCL builtins are opaque calls on PoCL that cost up to ~400 cycles and keep the
-// kernel scalar (../shared/notes/pocl-performance.md, rule 2); these vectorise.
+// kernel scalar (docs/pocl.md, rule 2); these vectorise.
 // tests/test_fastmath.cpp bounds their error against the C++ standard library.
+#include "namespace_check.h"
 #ifndef MA_FASTMATH_H
 #define MA_FASTMATH_H
 #include "common.h"

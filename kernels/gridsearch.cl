@@ -1,4 +1,4 @@
-// 000 Algorithm 1, lines 5–13, for every pixel at once: one work-item per block of 16
+// [HS14] Algorithm 1, lines 5–13, for every pixel at once: one work-item per block of 16
 // pixels adds the samples that kernels/sample.cl stored since the previous search
 // (kernels/stats.h, storedSampleIndex) to the pixel's running sums for the U weight
 // combinations, 16 of them per float16, and selects from the sums. Host side and C++
@@ -7,7 +7,7 @@
 // Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M) and
 // MA_GRID_VECTORS (B), the float16s of combinations summed in one pass over the samples.
 //
-// Shape (../shared/notes/pocl-performance.md): explicit float16 arithmetic is what
+// Shape (docs/pocl.md): explicit float16 arithmetic is what
 // reaches 512-bit code on PoCL. Lanes are combinations, not pixels, so a sample's
 // technique is the same in every lane: its sums need no masks, and a pixel's samples,
 // copied once grouped by technique, are read without tests. A division has the same
@@ -21,7 +21,7 @@
 #define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
 
 // Adds g and g² of technique j's n prepared samples (prepareSample) to its sums for the
-// combinations l0 … l0 + MA_PASS − 1 (000 Alg. 1 line 8; eq. 6.6 and 6.8 before dividing
+// combinations l0 … l0 + MA_PASS − 1 ([HS14] Alg. 1 line 8; eq. 6.6 and 6.8 before dividing
 // by m_j). alpha[v][k] holds α_k of the 16 combinations of vector v.
 MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
                         float16* sumG, float16* sumG2) {
@@ -134,7 +134,7 @@ MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const 
   }
 }
 
-// 000 Alg. 1 lines 5–13 for one pixel: adds the samples prepared at `prepared`
+// [HS14] Alg. 1 lines 5–13 for one pixel: adds the samples prepared at `prepared`
 // (summarised in `added`) to its running sums at `sums`, and, if `rank`, returns the
 // best l₀ by the sums of all its samples (summarised in `all`), or −1 if no
 // combination could be ranked. Rule (b) scores 16 combinations per float16; rule (a)

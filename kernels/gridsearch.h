@@ -1,4 +1,4 @@
-// Paper 000's Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
+// [HS14]'s Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
 // kernel (kernels/gridsearch.cl) and its C++ reference (host/alloc/GridSearch.cpp)
 // share, so that both compute bit for bit the same sums and rank the weight
 // combinations with the same code. Only the loop over samples × combinations is each
@@ -7,22 +7,16 @@
 // The sums over a pixel's samples are running sums: the grid α_l is fixed and a
 // sample's g = f/p_α never changes, so each search adds only the samples taken since
 // the previous one, and the pixel's summary (PixelSummary) carries over with them.
+#include "namespace_check.h"
 #ifndef MA_GRIDSEARCH_H
 #define MA_GRIDSEARCH_H
+#include "fallbacks.h"
 #include "fastmath.h"
 
-#define MA_GRID_MAX_TECHNIQUES 4
-
-// Which weight combination Algorithm 1 keeps (000 Alg. 1 line 13).
+// Which weight combination Algorithm 1 keeps ([HS14] Alg. 1 line 13).
 #define MA_RULE_MAX_ENTROPY 0        // as written: λ_{j,l} closest to uniform by entropy
 #define MA_RULE_MIN_COST_VARIANCE 1  // least cost × variance of the multi-sample estimator
 
-// The bits of host/alloc/Allocation.h's AllocationFallback (static_assert there).
-#define MA_FALLBACK_NON_FINITE 1u
-#define MA_FALLBACK_TOO_FEW_SAMPLES 2u
-#define MA_FALLBACK_NO_SIGNAL 4u
-#define MA_FALLBACK_SILENT_TECHNIQUE 8u
-#define MA_FALLBACK_SINGULAR_SYSTEM 64u
 
 // Value q of a pixel's sample i, with `pixelSamples` at the pixel's first value: the
 // layout of kernels/stats.h (storedSampleIndex), records of M + 2 rows of 16 pixels.

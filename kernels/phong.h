@@ -1,7 +1,8 @@
-// Physically corrected Lafortune–Phong BRDF (000 Sec. 5.2, eq. 6.13 with α measured
+// Physically corrected Lafortune–Phong BRDF ([HS14] Sec. 5.2, eq. 6.13 with α measured
 // from the mirror direction of ω_o) and its two sampling lobes: a cosine lobe about
 // the normal (z) and a cos^n lobe about the mirror direction. Host side:
 // host/scene/BrdfGrid.h holds the per-pixel parameters.
+#include "namespace_check.h"
 #ifndef MA_PHONG_H
 #define MA_PHONG_H
 #include "common.h"

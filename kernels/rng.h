@@ -1,6 +1,7 @@
 // Counter-based random numbers: Philox4x32-10 (Random123) keyed by the seed and
 // counted by (pixel, stream, sample index), so a sample's numbers do not depend on
 // the work-group size, the device, or which other samples were taken.
+#include "namespace_check.h"
 #ifndef MA_RNG_H
 #define MA_RNG_H
 #include "common.h"

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "Constants.h"
 #include "render/Method.h"
 #include "render/Sampler.h"
 #include "render/Scene.h"
@@ -35,7 +36,7 @@ inline MeanAndError pixelMean(const std::vector<double>& rgb) {
   const size_t n = rgb.size() / 3;
   double sum = 0, sumSquares = 0;
   for (size_t p = 0; p < n; ++p) {
-    double y = 0.2126 * rgb[3 * p] + 0.7152 * rgb[3 * p + 1] + 0.0722 * rgb[3 * p + 2];
+    double y = luminance(rgb[3 * p], rgb[3 * p + 1], rgb[3 * p + 2]);
     sum += y;
     sumSquares += y * y;
   }
@@ -53,7 +54,7 @@ inline double zScore(double mean, double expected, double standardError) {
   return (mean - expected) / std::max(standardError, 1e-6 * std::abs(expected));
 }
 
-// 000 eq. 6.17: the pixel value under R = cos^K θ with ω_o along the normal, R = 1.
+// [HS14] eq. 6.17: the pixel value under R = cos^K θ with ω_o along the normal, R = 1.
 inline double closedForm(double rhoD, double rhoS, double n, double K) {
   return 2 * rhoD / (K + 2) + rhoS * (n + 2) / (n + K + 2);
 }

@@ -1,5 +1,7 @@
 // The allocation rules of host/alloc on hand-made sums and samples. The numeric
-// oracles are copied from shared/papers/verified_values.json (key named in a comment).
+// oracles are the papers' numbers as recomputed independently with high-precision
+// quadrature (host/paper/PublishedValues.cpp; docs/papers.md), each labelled in a comment
+// by its example and quantity.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -63,7 +65,7 @@ PixelSamples threeTechniqueSamples(double (*f)(double), int perTechnique, std::u
 
 }  // namespace
 
-TEST_CASE("sampleVariance is the unbiased estimate of 000 eq. 6.19 and never negative", "[alloc]") {
+TEST_CASE("sampleVariance is the unbiased estimate of [HS14] eq. 6.19 and never negative", "[alloc]") {
   CHECK(sampleVariance(6, 14, 3) == Approx(1.0).epsilon(1e-15));  // values 1, 2, 3
   CHECK(sampleVariance(5, 25, 1) == 0);                           // one sample: undefined, reported as 0
   // 0.1 three times: cancellation in Σg² − (Σg)²/n must not produce a negative variance.
@@ -117,8 +119,8 @@ TEST_CASE("allocateEqual gives 1/M", "[alloc]") {
   CHECK_FALSE(a.usedFallback());
 }
 
-TEST_CASE("heuristicWeights reproduces 000 App. C (eq. 4.17 and eq. 4.20)", "[alloc]") {
-  // verified_values.json 000 appendix_C "V1", "V2", "V3" (s2 = 8.764) and
+TEST_CASE("heuristicWeights reproduces [HS14] App. C (eq. 4.17 and eq. 4.20)", "[alloc]") {
+  // verified value [HS14] appendix_C "V1", "V2", "V3" (s2 = 8.764) and
   // "alpha heuristic eq.4.17", "H({V1,V2,V3})".
   std::vector<double> v = {29.79279018, 23.4827951, 123.8956154};
   CHECK(harmonicMean(v) == Approx(35.62063444).epsilon(1e-8));
@@ -134,11 +136,11 @@ TEST_CASE("heuristicWeights reproduces 000 App. C (eq. 4.17 and eq. 4.20)", "[al
   CHECK(c.alpha[2] == Approx(0.05743057623).epsilon(1e-7));
 }
 
-TEST_CASE("heuristicWeights takes 000's limits for zero and infinite variances", "[alloc]") {
+TEST_CASE("heuristicWeights takes [HS14]'s limits for zero and infinite variances", "[alloc]") {
   Allocation infinite = heuristicWeights({4.09963, 35.3278, kInf}, {1, 1, 1});
   CHECK(infinite.alpha[2] == 0);
   CHECK(onSimplex(infinite.alpha));
-  // verified_values.json 002 example3 "alpha ~ 1/V[G]": the correct limit is [0.89602, 0.10398, 0.0].
+  // verified value [SHS16] example3 "alpha ~ 1/V[G]": the correct limit is [0.89602, 0.10398, 0.0].
   CHECK(infinite.alpha[0] == Approx(0.89602).epsilon(1e-5));
   CHECK_FALSE(infinite.usedFallback());
 
@@ -173,16 +175,16 @@ TEST_CASE("a cost ratio of 1:1000 scales the weights as the formulas say", "[all
   Allocation h = allocateHeuristic(stats, costs), h1 = allocateHeuristic(stats);
   REQUIRE(onSimplex(h.alpha));
   REQUIRE(h.alpha[1] > 0);
-  // 000 eq. 4.20: α_k ∝ 1/(c_k V_k), so the cost divides the weight ratio by 1000.
+  // [HS14] eq. 4.20: α_k ∝ 1/(c_k V_k), so the cost divides the weight ratio by 1000.
   CHECK(h.alpha[0] / h.alpha[1] == Approx(1000 * h1.alpha[0] / h1.alpha[1]).epsilon(1e-10));
 
   Allocation s = allocateSigmaSqrtC(stats, costs), s1 = allocateSigmaSqrtC(stats);
   REQUIRE(onSimplex(s.alpha));
-  // 002 eq. 31: n_i ∝ σ_i/√c_i.
+  // [SHS16] eq. 31: n_i ∝ σ_i/√c_i.
   CHECK(s.alpha[0] / s.alpha[1] == Approx(std::sqrt(1000.0) * s1.alpha[0] / s1.alpha[1]).epsilon(1e-10));
 }
 
-TEST_CASE("sigmaSqrtCWeights follows 002 eq. 31 and falls back when every sigma is 0", "[alloc]") {
+TEST_CASE("sigmaSqrtCWeights follows [SHS16] eq. 31 and falls back when every sigma is 0", "[alloc]") {
   Allocation a = sigmaSqrtCWeights({1.0, 2.0, 3.0}, {1, 4, 9});
   CHECK(a.alpha[0] == Approx(1.0 / 3));
   CHECK(a.alpha[1] == Approx(1.0 / 3));
@@ -194,19 +196,19 @@ TEST_CASE("sigmaSqrtCWeights follows 002 eq. 31 and falls back when every sigma 
 }
 
 TEST_CASE("an equal-valued pilot gives a zero variance estimate, not 0/0", "[alloc]") {
-  // f = 1 = p_0: technique 0's estimator f/p_0 is constant, so V_0 = 0 and, by 000's
+  // f = 1 = p_0: technique 0's estimator f/p_0 is constant, so V_0 = 0 and, by [HS14]'s
   // limit V_k → 0, it takes all the weight.
   PixelSamples samples = twoTechniqueSamples([](double) { return 1.0; }, 50, 3);
   Allocation h = allocateHeuristic(samples.stats());
   CHECK(h.alpha == std::vector<double>{1.0, 0.0});
   CHECK(h.fallbacks & kFallbackZeroVariance);
 
-  // f = p_0 + p_1: f/Σp = 1 for every sample, so every σ_i of 002 eq. 28 is 0.
+  // f = p_0 + p_1: f/Σp = 1 for every sample, so every σ_i of [SHS16] eq. 28 is 0.
   PixelSamples sum = twoTechniqueSamples([](double x) { return 1 + 2 * x; }, 50, 3);
   Allocation s = allocateSigmaSqrtC(sum.stats());
   CHECK(s.alpha == std::vector<double>{0.5, 0.5});
   CHECK(s.fallbacks == kFallbackZeroVariance);
-  // The linear heuristic is exact for a mixture integrand (003 Sec. 7): f = 2 p_α, α = 1/2.
+  // The linear heuristic is exact for a mixture integrand ([SS23] Sec. 7): f = 2 p_α, α = 1/2.
   for (ZeroWeightRule rule : {ZeroWeightRule::DropMostNegative, ZeroWeightRule::MinSampleVariance}) {
     Allocation l = allocateLinear(sum, rule);
     CHECK(l.alpha[0] == Approx(0.5).epsilon(1e-12));
@@ -257,7 +259,7 @@ TEST_CASE("unusable sums fall back to equal weights with the reason", "[alloc]")
   }
 }
 
-TEST_CASE("003 eq. 17 and the general eq. 14 solver agree for two techniques", "[alloc]") {
+TEST_CASE("[SS23] eq. 17 and the general eq. 14 solver agree for two techniques", "[alloc]") {
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     PixelSamples samples = twoTechniqueSamples([](double x) { return std::exp(x) + std::sin(3 * x); }, 30, seed);
     std::optional<double> closed = linearPairWeight(samples.stats(), 0, 1);
@@ -279,7 +281,7 @@ TEST_CASE("the linear heuristic recovers a mixture integrand exactly for M = 3",
   CHECK(a.zeroedWeights == 0);
 }
 
-TEST_CASE("003 Sec. 5.1: both zero-weight techniques return a feasible boundary solution", "[alloc]") {
+TEST_CASE("[SS23] Sec. 5.1: both zero-weight techniques return a feasible boundary solution", "[alloc]") {
   // f = x⁴ is steeper than every technique: the raw eq. 14 solution has negative weights.
   PixelSamples samples = threeTechniqueSamples([](double x) { return x * x * x * x; }, 100, 21);
   std::optional<std::vector<double>> raw = solveLinearSystem(samples.stats(), 0b111);
@@ -306,7 +308,7 @@ TEST_CASE("003 Sec. 5.1: both zero-weight techniques return a feasible boundary 
   }
 }
 
-TEST_CASE("mixtureSampleVariance is 003 eq. 19", "[alloc]") {
+TEST_CASE("mixtureSampleVariance is [SS23] eq. 19", "[alloc]") {
   PixelSamples samples(2);
   double a[2] = {1.0, 3.0}, b[2] = {2.0, 2.0}, c[2] = {4.0, 0.0};
   samples.add(0, 2.0, a);

@@ -38,7 +38,7 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
   CHECK(j["method"] == "exact");
   CHECK(j["spp"] == 8);
-  CHECK(j["reference"]["source"] == "analytic (000 eq. 6.17)");
+  CHECK(j["reference"]["source"] == "analytic ([HS14] eq. 6.17)");
   CHECK(j["rmse_x1000"].get<double>() > 0);
   CHECK(j["time_s"]["kernel"].get<double>() > 0);
   CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());

@@ -145,7 +145,7 @@ TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][comp
   nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
   CHECK(runs["interrupted"] == false);
   CHECK(runs["runs"].size() == 4 * 2 * 2);
-  CHECK(runs["cases"][0]["reference"] == "analytic (000 eq. 6.17)");
+  CHECK(runs["cases"][0]["reference"] == "analytic ([HS14] eq. 6.17)");
   nlohmann::json summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
   CHECK(summary["table_spp"] == 20);
   for (const auto& m : summary["cases"][0]["methods"]) {

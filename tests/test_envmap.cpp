@@ -13,8 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "Constants.h"
 #include "Error.h"
 #include "KernelCode.h"
+#include "Statistics.h"
 #include "render/KernelViews.h"
 #include "scene/AliasTable.h"
 #include "scene/Envmap.h"
@@ -25,15 +27,15 @@ using Catch::Matchers::Contains;
 using misalloc::Envmap;
 using misalloc::EnvmapSampler;
 using misalloc::EnvmapTables;
+using misalloc::kPi;
 using misalloc::RgbImage;
+using misalloc::test::ChiSquare;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kFloatRounding = 0x1p-24;  // relative error of one rounding to float
 constexpr double kDoubleRounding = 0x1p-53;
 constexpr double kGrid24 = 0x1p24;  // uniformFloat's values are k / 2^24
-constexpr double kPValueThreshold = 1e-3;
 
 // The view the renderer hands the kernels; the maps here keep their image radiance.
 kern::EnvmapView viewOf(const EnvmapTables& tables) { return misalloc::makeEnvmapView(tables, -1); }
@@ -98,70 +100,6 @@ const std::vector<NamedMap>& testMaps() {
   return maps;
 }
 
-// Q(a, x) = Γ(a, x) / Γ(a), the regularised upper incomplete gamma function: the
-// series for P below a + 1, Lentz's continued fraction for Q above (Numerical
-// Recipes §6.2). The loops stop when terms no longer change a double.
-double upperRegularisedGamma(double a, double x) {
-  if (x <= 0) return 1;
-  const double logPrefix = a * std::log(x) - x - std::lgamma(a);
-  const double tiny = std::numeric_limits<double>::min();
-  if (x < a + 1) {
-    double term = 1 / a, sum = term;
-    for (int n = 1; term > sum * kDoubleRounding; ++n) {
-      term *= x / (a + n);
-      sum += term;
-    }
-    return 1 - sum * std::exp(logPrefix);
-  }
-  double b = x + 1 - a, c = 1 / tiny, d = 1 / b, h = d;
-  for (int i = 1;; ++i) {
-    double an = -i * (i - a);
-    b += 2;
-    d = an * d + b;
-    d = std::abs(d) < tiny ? tiny : d;
-    c = b + an / c;
-    c = std::abs(c) < tiny ? tiny : c;
-    d = 1 / d;
-    h *= d * c;
-    if (std::abs(d * c - 1) <= kDoubleRounding) break;
-  }
-  return std::exp(logPrefix) * h;
-}
-
-struct ChiSquare {
-  double statistic = 0;
-  int degreesOfFreedom = 0;
-  double pValue() const { return upperRegularisedGamma(0.5 * degreesOfFreedom, 0.5 * statistic); }
-};
-
-// Pearson's test of observed counts against probabilities. Bins expecting fewer than
-// 5 counts, where the χ² approximation fails, are pooled; a pool still below 5 joins
-// the smallest regular bin.
-ChiSquare chiSquare(const std::vector<uint64_t>& observed, const std::vector<double>& probability, uint64_t n) {
-  std::vector<std::pair<double, double>> bins;  // expected, observed
-  double pooledExpected = 0, pooledObserved = 0;
-  for (std::size_t i = 0; i < observed.size(); ++i) {
-    double expected = probability[i] * double(n);
-    if (expected >= 5) {
-      bins.emplace_back(expected, double(observed[i]));
-    } else {
-      pooledExpected += expected;
-      pooledObserved += double(observed[i]);
-    }
-  }
-  if (pooledExpected >= 5 || bins.empty()) {
-    bins.emplace_back(pooledExpected, pooledObserved);
-  } else {
-    auto smallest = std::min_element(bins.begin(), bins.end());
-    smallest->first += pooledExpected;
-    smallest->second += pooledObserved;
-  }
-  ChiSquare result;
-  for (const auto& [expected, count] : bins) result.statistic += (count - expected) * (count - expected) / expected;
-  result.degreesOfFreedom = int(bins.size()) - 1;
-  return result;
-}
-
 // How many of the 2^24 values k / 2^24 of uniformFloat lie below x ∈ [0, 1].
 double gridCountBelow(float x) { return std::ceil(double(x) * kGrid24); }
 
@@ -209,13 +147,6 @@ double totalVariation(const std::vector<double>& p, const std::vector<double>& q
 
 }  // namespace
 
-TEST_CASE("the χ² p-value helper matches tabulated quantiles", "[envmap]") {
-  CHECK(upperRegularisedGamma(0.5, 0.5 * 3.841459) == Approx(0.05).epsilon(1e-5));
-  CHECK(upperRegularisedGamma(5.0, 0.5 * 18.307038) == Approx(0.05).epsilon(1e-5));
-  CHECK(upperRegularisedGamma(50.0, 0.5 * 135.806723) == Approx(0.01).epsilon(1e-5));
-  CHECK(upperRegularisedGamma(5000.0, 0.5 * 10000.0) == Approx(0.5).epsilon(1e-2));
-}
-
 TEST_CASE("kern::searchCdf returns the last index i with cdf[i] <= u", "[envmap]") {
   // Every CDF of n ≤ 9 steps over the values {0, 0.25, 0.5, 1} (ties and jumps at
   // both ends), probed at each value it holds and between them.
@@ -261,7 +192,7 @@ TEST_CASE("buildEnvmapTables lays out the tables that kernels/envmap.h reads", "
     for (std::size_t t = 0; t < 15; ++t)
       for (int c = 0; c < 3; ++c) CHECK(tables.texels[4 * t + c] == map.image.rgb[3 * t + c]);
     // Texel (col, row) has weight luminance × sin θ at its centre.
-    double luminance0 = 0.2126 * 7 + 0.7152 + 0.0722;
+    double luminance0 = misalloc::luminance(7, 1, 1);
     double weight0 = luminance0 * std::sin(kPi / 6), weight14 = 25 * std::sin(5 * kPi / 6);
     // The CDF sampler's probabilities are what its float CDFs draw (checked below).
     if (sampler == EnvmapSampler::Alias)
@@ -385,7 +316,9 @@ TEST_CASE("envmapLookup at a texel's centre returns that texel's radiance and pd
 }
 
 TEST_CASE("the kernels' samplers draw texels with the stored probabilities, never one of weight 0", "[envmap]") {
-  // The compensated pdf ([Kar19] eq. 14) zeroes every texel at or below the mean.
+  // The compensated pdf ([Kar19] eq. 14) zeroes every texel at or below the mean. One χ²
+  // test per pdf, map and sampler; a false alarm in any of them with probability 2 %.
+  const double level = misalloc::test::sidakLevel(0.02, int(2 * 2 * testMaps().size()));
   for (const std::string pdf : {"plain", "compensated"})
     for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
       const bool cdf = sampler == EnvmapSampler::Cdf;
@@ -416,9 +349,9 @@ TEST_CASE("the kernels' samplers draw texels with the stored probabilities, neve
         uint64_t zeroWeightDraws = 0;
         for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
         CHECK(zeroWeightDraws == 0);
-        ChiSquare test = chiSquare(counts, p, samples);
+        ChiSquare test = misalloc::test::chiSquare(counts, p, samples);
         INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
-        if (test.degreesOfFreedom > 0) CHECK(test.pValue() > kPValueThreshold);
+        if (test.degreesOfFreedom > 0) CHECK(test.pValue() > level);
       }
     }
 }
@@ -543,7 +476,7 @@ TEST_CASE("makeEnvmap's sun keeps its power at any size and resolution", "[envma
     const RgbImage& im = map.image;
     auto luminance = [&](int col, int row) {
       const float* p = &im.rgb[3 * (std::size_t(row) * im.width + col)];
-      return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      return misalloc::luminance(p[0], p[1], p[2]);
     };
     double excess = 0;
     for (int row = 0; row < im.height; ++row) {
@@ -576,7 +509,7 @@ TEST_CASE("makeEnvmap's sun keeps its power at any size and resolution", "[envma
   for (int row = 0; row < height / 2; ++row) {
     CHECK(at(400, row, 2) > at(400, row, 0));
     if (row > 0) CHECK(at(400, row, 1) > at(400, row - 1, 1));
-    maxSky = std::max(maxSky, 0.2126 * at(400, row, 0) + 0.7152 * at(400, row, 1) + 0.0722 * at(400, row, 2));
+    maxSky = std::max(maxSky, misalloc::luminance(at(400, row, 0), at(400, row, 1), at(400, row, 2)));
   }
   for (int row = height / 2; row < height; ++row) CHECK(at(400, row, 1) < at(400, 0, 1));
   // RATIO is relative to the sky's brightest radiance, at the horizon; the texels

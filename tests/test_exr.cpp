@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "Constants.h"
 #include "Error.h"
 #include "RawExr.h"
 #include "scene/ExrIO.h"
@@ -27,12 +28,12 @@
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
 using misalloc::InputError;
+using misalloc::kPi;
 using misalloc::readExr;
 using misalloc::RgbImage;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // A fresh folder for one test case, removed with its contents afterwards.
 struct ScratchDir {
@@ -142,7 +143,7 @@ TEST_CASE("readExr reads the shipped maps as stats.json describes them", "[exr]"
           2 * kPi / image.width * (std::cos(kPi * row / image.height) - std::cos(kPi * (row + 1) / image.height));
       for (int col = 0; col < image.width; ++col) {
         const float* p = &image.rgb[3 * (std::size_t(row) * image.width + col)];
-        power += (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) * solidAngle;
+        power += misalloc::luminance(p[0], p[1], p[2]) * solidAngle;
       }
     }
     // Both sums are in double over the same float values; only their order differs,

@@ -1,11 +1,13 @@
-// The papers' 1D examples (host/paper) against the independently verified values of
-// shared/papers/verified_values.json, copied here with the JSON key they come from.
+// The papers' 1D examples (host/paper) against the papers' numbers as recomputed
+// independently with high-precision quadrature (host/paper/PublishedValues.cpp;
+// docs/papers.md), each labelled by its example and quantity.
 // Tolerances match the digits the paper prints, or are tighter.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "Constants.h"
 #include "alloc/HeuristicAllocation.h"
 #include "alloc/SigmaAllocation.h"
 #include "paper/Flatland.h"
@@ -21,7 +23,6 @@ using namespace misalloc;
 
 namespace {
 
-const double kPi = std::acos(-1.0);
 const std::vector<double> kUnit3 = {1, 1, 1};
 const std::vector<double> kEqual3 = {1.0 / 3, 1.0 / 3, 1.0 / 3};
 
@@ -93,9 +94,9 @@ TEST_CASE("second moments are classified before they are integrated", "[paper]")
   CHECK(singleDensity(shifted, shifted, 0, 1).classify({1}) == VarianceStatus::SignedDensity);
 }
 
-TEST_CASE("000 App. C, first block (s2 = 8.764 as printed)", "[paper]") {
+TEST_CASE("[HS14] App. C, first block (s2 = 8.764 as printed)", "[paper]") {
   Example1D c = example000AppendixC(AppendixCNormalisation::AsPrinted);
-  CHECK(c.integral() == Approx(10.28836765).epsilon(1e-9));  // 000 appendix_C "I"
+  CHECK(c.integral() == Approx(10.28836765).epsilon(1e-9));  // [HS14] appendix_C "I"
   std::vector<VarianceValue> v;
   for (int k = 0; k < 3; ++k) v.push_back(techniqueVariance(c, k));
   CHECK(v[0].value == Approx(29.79279018).epsilon(1e-9));  // "V1"
@@ -119,7 +120,7 @@ TEST_CASE("000 App. C, first block (s2 = 8.764 as printed)", "[paper]") {
   checkVector(atEqual.techniqueSecondMoment, {143.5134654, 162.0052842, 112.2668235}, 1e-9);  // "E_j at equal alpha"
 }
 
-TEST_CASE("000 App. C: the printed grid minimum is a negative 'mixture'; valid ones are searched", "[paper]") {
+TEST_CASE("[HS14] App. C: the printed grid minimum is a negative 'mixture'; valid ones are searched", "[paper]") {
   Example1D c = example000AppendixC(AppendixCNormalisation::AsPrinted);
   // "grid minimum (step 0.01)": the published 23.247 sits at (0, 0.95, 0.05), where
   // p_α < 0 on (0, ~0.09) and f ≠ 0 there: a pole, no number.
@@ -142,7 +143,7 @@ TEST_CASE("000 App. C: the printed grid minimum is a negative 'mixture'; valid o
   CHECK(c.classify(best.alpha) == VarianceStatus::Finite);
 }
 
-TEST_CASE("000 App. C, cost block (exact s2)", "[paper]") {
+TEST_CASE("[HS14] App. C, cost block (exact s2)", "[paper]") {
   Example1D c = example000AppendixC(AppendixCNormalisation::Exact);
   CHECK(c.pdf(1).normalisation() == Approx(8.764629233).epsilon(1e-10));  // "s2 = int (x^2-x/pi)"
   CHECK(c.pdf(0).normalisation() == Approx(4.934802201).epsilon(1e-10));  // "s1 = pi^2/2"
@@ -165,14 +166,14 @@ TEST_CASE("000 App. C, cost block (exact s2)", "[paper]") {
   CHECK(inefficiency(c.costs(), kEqual3, vEqual) / best.inefficiency == Approx(3.933034063).epsilon(1e-8));
 }
 
-TEST_CASE("000 App. C cannot be sampled: technique 2 is no density on [0, pi]", "[paper]") {
+TEST_CASE("[HS14] App. C cannot be sampled: technique 2 is no density on [0, pi]", "[paper]") {
   Example1D c = example000AppendixC(AppendixCNormalisation::Exact);
   CHECK_THROWS_AS(runAllocationStudy(c, {2, 10, 1}), std::domain_error);
 }
 
-TEST_CASE("002 App. A, Example 1", "[paper]") {
+TEST_CASE("[SHS16] App. A, Example 1", "[paper]") {
   Example1D e = example002(1);
-  // 002 "normalisations".
+  // [SHS16] "normalisations".
   CHECK(e.pdf(0).normalisation() == Approx(4.820815869).epsilon(1e-9));
   CHECK(e.pdf(1).normalisation() == Approx(8.764629233).epsilon(1e-9));
   CHECK(e.pdf(2).normalisation() == Approx(1.88816276).epsilon(1e-9));
@@ -204,7 +205,7 @@ TEST_CASE("002 App. A, Example 1", "[paper]") {
         Approx(102.2663413).epsilon(1e-8));  // "ex1 equal count"
 }
 
-TEST_CASE("002 App. A, Example 2", "[paper]") {
+TEST_CASE("[SHS16] App. A, Example 2", "[paper]") {
   Example1D e = example002(2);
   CHECK(e.integral() == Approx(3.596147594).epsilon(1e-9));
   checkVector(techniqueVariances(e), {5.633398005, 9.41987685, 4.544642855}, 1e-9);
@@ -226,7 +227,7 @@ TEST_CASE("002 App. A, Example 2", "[paper]") {
         Approx(15.44411475).epsilon(1e-8));  // table5 "ex2 n_i ~ sigma_i/sqrt(c_i)"
 }
 
-TEST_CASE("002 App. A, Examples 3 and 4: V[G3] is infinite, not 9586.73", "[paper]") {
+TEST_CASE("[SHS16] App. A, Examples 3 and 4: V[G3] is infinite, not 9586.73", "[paper]") {
   Example1D e3 = example002(3);
   CHECK(e3.integral() == Approx(15.47360786).epsilon(1e-9));
   VarianceValue g3 = techniqueVariance(e3, 2);
@@ -260,7 +261,7 @@ TEST_CASE("002 App. A, Examples 3 and 4: V[G3] is infinite, not 9586.73", "[pape
 }
 
 TEST_CASE("zero-variance mixtures give 0, not 0/0", "[paper]") {
-  // 002 example4 "V(1/3,1/3,1/3)": 1.15e-9, zero but for the rounded 8.764 in f.
+  // [SHS16] example4 "V(1/3,1/3,1/3)": 1.15e-9, zero but for the rounded 8.764 in f.
   Example1D e4 = example002(4);
   MixtureMoments atEqual = mixtureMoments(e4, kEqual3);
   double v = oneSampleVariance(atEqual, e4.integral()).value;
@@ -271,7 +272,7 @@ TEST_CASE("zero-variance mixtures give 0, not 0/0", "[paper]") {
   CHECK(inefficiency(e4.costs(), alphaSigma, countIndependentVariance(sigmas, alphaSigma)) ==
         Approx(2.738186913e-09).epsilon(1e-3));  // table5 "ex4 n_i ~ sigma_i/sqrt(c_i)"
 
-  // 003 example2 "V minimum (not printed)": f is exactly 0.99379 p1 + 1.99914 p2.
+  // [SS23] example2 "V minimum (not printed)": f is exactly 0.99379 p1 + 1.99914 p2.
   Example1D e2 = example003(2);
   OptimalMixture best = minimiseInefficiency(e2, VarianceModel::MultiSample, {1, 1});
   CHECK(std::abs(best.variance) < 1e-10);
@@ -293,8 +294,8 @@ TEST_CASE("zero-variance mixtures give 0, not 0/0", "[paper]") {
   }
 }
 
-TEST_CASE("003 examples: integrals, equal-budget and minimal variances", "[paper]") {
-  // 003 exampleN "integral", "V equal budget", "V minimum", with the example_mapping.
+TEST_CASE("[SS23] examples: integrals, equal-budget and minimal variances", "[paper]") {
+  // [SS23] exampleN "integral", "V equal budget", "V minimum", with the example_mapping.
   struct Expected {
     int number;
     double integral, vEqual, vMin;
@@ -309,7 +310,7 @@ TEST_CASE("003 examples: integrals, equal-budget and minimal variances", "[paper
       {6, 3.596147594, 4.917558119, 4.194486753, {0.0, 0.1985623886, 0.8014376114}},
   };
   for (const Expected& x : expected) {
-    INFO("003 example " << x.number);
+    INFO("[SS23] example " << x.number);
     Example1D e = example003(x.number);
     int m = e.techniqueCount();
     CHECK(e.integral() == Approx(x.integral).epsilon(1e-9));
@@ -323,8 +324,8 @@ TEST_CASE("003 examples: integrals, equal-budget and minimal variances", "[paper
   CHECK(minimiseInefficiency(example003(6), VarianceModel::MultiSample, kUnit3).alpha[0] == 0);
 }
 
-TEST_CASE("003: the linear heuristic with 100 samples per technique, both Sec. 5.1 techniques", "[paper]") {
-  // 003 exampleN "linear heuristic MC study (200 runs x 100 samples/technique)": median,
+TEST_CASE("[SS23]: the linear heuristic with 100 samples per technique, both Sec. 5.1 techniques", "[paper]") {
+  // [SS23] exampleN "linear heuristic MC study (200 runs x 100 samples/technique)": median,
   // p10, p90 of the exact variance at the heuristic's α, for technique 1 and 2. Another
   // implementation's random numbers, so the checks are statistical: the median of 200
   // runs has a standard error of about 0.035 (p90 − p10); medians must agree within
@@ -350,7 +351,7 @@ TEST_CASE("003: the linear heuristic with 100 samples per technique, both Sec. 5
     CHECK(ours.p90 == Approx(reference.p90).margin(0.5 * width));
   };
   for (const Expected& x : expected) {
-    INFO("003 example " << x.number);
+    INFO("[SS23] example " << x.number);
     std::vector<RuleOutcome> study = runAllocationStudy(example003(x.number), {200, 100, 2024});
     const RuleOutcome& first = outcome(study, AllocationRule::LinearDropMostNegative);
     const RuleOutcome& second = outcome(study, AllocationRule::LinearMinSampleVariance);
@@ -364,7 +365,7 @@ TEST_CASE("003: the linear heuristic with 100 samples per technique, both Sec. 5
       // "runs_with_negative_solution": 199 of 200; the optimum is on α₁ = 0.
       CHECK(first.boundaryRuns >= 190);
       CHECK(second.boundaryRuns >= 190);
-      // 003 Sec. 6.1: the second technique is the more accurate one (Figs. 17, 18).
+      // [SS23] Sec. 6.1: the second technique is the more accurate one (Figs. 17, 18).
       CHECK(second.inefficiency.p90 <= first.inefficiency.p90);
     }
   }

@@ -30,8 +30,8 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference", "[sampler]") {
   };
   for (bool split : {false, true}) {
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      const Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s);  // once per map and sampler
       for (const SamplerConfig& config : configs) {
-        Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s);
         StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
         // Counts that differ from pixel to pixel, each technique at least one: work-groups
         // then mix counts (kernels/sample.cl runs each technique's loop for the largest).

@@ -22,7 +22,7 @@ std::string image(const std::string& path, const std::string& title) {
 }
 
 // Rows = methods, columns = budgets: each repeat-0 preview, then the α map at the
-// table budget (blue = envmap sampling, red = BRDF sampling, as 000 Fig. 5.5).
+// table budget (blue = envmap sampling, red = BRDF sampling, as [HS14] Fig. 5.5).
 std::string imageGrid(const Summary& s, const CaseSummary& c) {
   std::string out = "<table>\n<tr><th>method</th>";
   for (int b : s.budgets) out += fmt::format("<th>{} spp</th>", b);
@@ -63,7 +63,7 @@ std::string indexHtml(const Summary& s) {
         "scene's reference; "
         "the spread is the standard deviation over repeats with independent seeds.</p>\n",
         s.cases.front().info.device, fmt::join(s.budgets, ", "));
-  out += fmt::format("<h2>RMSE×1000 at {} spp (000 Table 5.2 layout)</h2>\n", s.tableBudget) + html(rmseTable(s));
+  out += fmt::format("<h2>RMSE×1000 at {} spp ([HS14] Table 5.2 layout)</h2>\n", s.tableBudget) + html(rmseTable(s));
   for (int budget : speedUpBudgets(s))
     out += fmt::format("<h2>Speed-up over equal at equal error, {} spp</h2>\n", budget) + html(speedUpTable(s, budget));
   out += fmt::format("<h2>Seconds per render at {} spp: wall (kernel + allocation)</h2>\n", s.tableBudget) +

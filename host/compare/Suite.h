@@ -8,7 +8,7 @@ namespace misalloc {
 
 // `compare --suite`: every shipped envmap × the seed000 grid with the alias sampler,
 // plus the default map with the binary-search (CDF) sampler, whose measured cost
-// ratio is the one where the cost-aware allocations matter (000 Sec. 5.2: c_BRDF =
+// ratio is the one where the cost-aware allocations matter ([HS14] Sec. 5.2: c_BRDF =
 // 0.21 c_EM with a binary search).
 std::vector<CompareCase> suiteCases(int width, int height);
 

@@ -6,7 +6,7 @@
 namespace misalloc {
 
 // The per-pixel allocation as two files: an EXR with one channel alpha.<technique>
-// per technique, and a false-colour PNG as in 000 Fig. 5.5: blue = envmap sampling
+// per technique, and a false-colour PNG as in [HS14] Fig. 5.5: blue = envmap sampling
 // only, red = BRDF sampling only (both lobes when split).
 struct AlphaMapFiles {
   std::string exr, png;

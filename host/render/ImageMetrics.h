@@ -3,7 +3,7 @@
 
 namespace misalloc {
 
-// Root mean squared error over all pixels and RGB channels (000 Table 5.2 reports
+// Root mean squared error over all pixels and RGB channels ([HS14] Table 5.2 reports
 // it ×1000).
 double rmse(const RgbImage& image, const RgbImage& reference);
 

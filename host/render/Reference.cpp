@@ -37,7 +37,7 @@ std::optional<RgbImage> analyticReference(const Scene& scene) {
   image.height = scene.grid.height;
   image.rgb.reserve(scene.grid.pixels.size() * 3);
   for (const auto& p : scene.grid.pixels) {
-    double L = 2.0 * p.rhoD / (K + 2.0) + double(p.rhoS) * (p.n + 2.0) / (p.n + K + 2.0);  // 000 eq. 6.17
+    double L = 2.0 * p.rhoD / (K + 2.0) + double(p.rhoS) * (p.n + 2.0) / (p.n + K + 2.0);  // [HS14] eq. 6.17
     for (int c = 0; c < 3; ++c) image.rgb.push_back(float(L));
   }
   return image;
@@ -93,7 +93,7 @@ std::string defaultCacheDir() {
 
 std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
                                        bool computeIfMissing) {
-  if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic (000 eq. 6.17)", ""};
+  if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic ([HS14] eq. 6.17)", ""};
   fs::path path = fs::path(cacheDir) / "references" / (referenceKey(scene, spp) + ".exr");
   std::string source = fmt::format("equal-count MIS, {} spp", spp);
   if (fs::exists(path)) return Reference{readExr(path.string()), source + " (cached)", path.string()};

@@ -10,11 +10,11 @@ namespace misalloc {
 
 struct Reference {
   RgbImage image;
-  std::string source;  // "analytic (000 eq. 6.17)", or how it was sampled
+  std::string source;  // "analytic ([HS14] eq. 6.17)", or how it was sampled
   std::string path;    // the cached file, if any
 };
 
-// 000 eq. 6.17: for R = cos^K θ and ω_o along the normal, L = R(2ρd/(K+2) +
+// [HS14] eq. 6.17: for R = cos^K θ and ω_o along the normal, L = R(2ρd/(K+2) +
 // ρs(n+2)/(n+K+2)), exact. Empty for any other scene.
 std::optional<RgbImage> analyticReference(const Scene& scene);
 

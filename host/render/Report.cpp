@@ -13,7 +13,7 @@ std::string estimatorName(Estimator estimator) {
     case Estimator::OneSample:
       return "one-sample balance heuristic";
     case Estimator::CountIndependent:
-      return "count-independent weights (002 eq. 26)";
+      return "count-independent weights ([SHS16] eq. 26)";
   }
   return "?";
 }
@@ -103,14 +103,14 @@ nlohmann::json renderReport(const RenderRun& run) {
       report["allocation"]["grid_u"] = run.adaptive.gridSize;
       report["allocation"]["grid_selection"] =
           run.method == Method::Exact && run.adaptive.gridRule == GridRule::MaxEntropy
-              ? "maximum entropy of normalised lambda (000 Alg. 1 line 13)"
-              : "minimum cost x multi-sample variance (002 eq. 21)";
+              ? "maximum entropy of normalised lambda ([HS14] Alg. 1 line 13)"
+              : "minimum cost x multi-sample variance ([SHS16] eq. 21)";
     }
     if (run.method == Method::Oracle) report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
     if (run.method == Method::Linear)
       report["allocation"]["zero_weight_rule"] = run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance
-                                                     ? "min sample variance (003 eq. 19)"
-                                                     : "drop most negative (003 Sec. 5.1)";
+                                                     ? "min sample variance ([SS23] eq. 19)"
+                                                     : "drop most negative ([SS23] Sec. 5.1)";
   }
   if (run.reference) {
     report["reference"] = {{"source", run.reference->source}, {"path", run.reference->path}};

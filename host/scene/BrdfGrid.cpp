@@ -38,7 +38,7 @@ BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height) {
   std::function<PhongParameters(double, double)> at;
   if (kind == "seed000" && args.empty()) {
     at = [](double u, double v) {
-      double rhoD = (1 - v) * (1 - v);  // 000 Sec. 5.2
+      double rhoD = (1 - v) * (1 - v);  // [HS14] Sec. 5.2
       return PhongParameters{float(rhoD), float(1 - rhoD), seed000Exponent(float(u))};
     };
   } else if (kind == "general") {

@@ -18,7 +18,7 @@ struct BrdfGrid {
   const PhongParameters& at(int x, int y) const { return pixels[size_t(y) * width + x]; }
 };
 
-// 000 Sec. 5.2: ρd(y) = (1−y)², ρs = 1−ρd, n(x) = −1 − 0.111211/(0.1 x^0.2 − 0.101101).
+// [HS14] Sec. 5.2: ρd(y) = (1−y)², ρs = 1−ρd, n(x) = −1 − 0.111211/(0.1 x^0.2 − 0.101101).
 float seed000Exponent(float x);
 
 // spec: "seed000"; "general:RD0,RD1,N0,N1" (ρd from RD0 at the top to RD1 at the

@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <vector>
 
+#include "Constants.h"
 #include "Error.h"
 
 namespace misalloc {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxProceduralWidth = 16384;  // 16384 × 8192 texels: 1.5 GiB of RGB floats
 // The brightest radiance rendered. A sample reaches about 3e6 times the radiance
 // (Phong lobes up to n = 1e5, 4π sr, a blue texel whose luminance is 7 % of its
@@ -49,7 +49,7 @@ struct Rgb {
   double r, g, b;
 };
 
-double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+double luminance(const Rgb& c) { return misalloc::luminance(c.r, c.g, c.b); }
 
 // cos θ at the midpoint of sub-row s of n, in equal steps of cos θ: since dω = dφ
 // d(cos θ), each sub-row covers the same solid angle, so a texel's solid-angle average

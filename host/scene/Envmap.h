@@ -12,7 +12,7 @@ namespace misalloc {
 struct Envmap {
   RgbImage image;
   // ≥ 0: the radiance is analytically cos^K θ (white) on the upper hemisphere and 0
-  // below it (000 App. D); the image is then that function rasterised and only
+  // below it ([HS14] App. D); the image is then that function rasterised and only
   // shapes the sampling pdf. < 0: the image is the radiance.
   float coskExponent = -1;
   std::string description;  // for logs and reports, e.g. "sun:40,90,0.5,1e+05 (512×256)"
@@ -22,7 +22,7 @@ struct Envmap {
 //   PATH            an OpenEXR file (see readExr; `warnings` receives its repairs)
 //   constant        radiance 1 everywhere
 //   constant:R      radiance R ≥ 0 everywhere
-//   cosk:K          cos^K θ on the upper hemisphere, 0 below, K ≥ 0 (000 App. D)
+//   cosk:K          cos^K θ on the upper hemisphere, 0 below, K ≥ 0 ([HS14] App. D)
 //   sun             sun:40,90,0.5,1e5
 //   sun:THETA,PHI,RADIUS,RATIO
 //                   a bluish sky brightening from zenith to horizon over a dim ground,
