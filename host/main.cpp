@@ -125,14 +125,14 @@ struct AdaptiveArgs {
         ->capture_default_str()
         ->check(realIn(0, 1, false, true));
     costOption = app->add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
-    app->add_option("--linear-rule", linearRule, "linear: negative weights by variance (003 eq. 19) or drop")
+    app->add_option("--linear-rule", linearRule, "linear: negative weights by variance ([SS23] eq. 19) or drop")
         ->capture_default_str();
     // α is a float: beyond 2^24 combinations, neighbouring weights would coincide.
     app->add_option("--grid-u", options.gridSize, "exact, oracle: number U of weight combinations searched")
         ->capture_default_str()
         ->check(integerIn(2, 1 << 24));
     app->add_option("--grid-rule", gridRule,
-                    "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, 000 Alg. 1)")
+                    "exact: select by minimum cost x variance (variance) or maximum entropy (entropy, [HS14] Alg. 1)")
         ->capture_default_str();
     app->add_option("--oracle-spp", options.oracleSamples, "oracle: probe samples per pixel")
         ->capture_default_str()
@@ -153,7 +153,7 @@ GridRule parseGridRule(const std::string& name) {
 ZeroWeightRule parseLinearRule(const std::string& name) {
   if (name == "variance") return ZeroWeightRule::MinSampleVariance;
   if (name == "drop") return ZeroWeightRule::DropMostNegative;
-  throw InputError(fmt::format("--linear-rule '{}': expected variance (003 eq. 19) or drop", name));
+  throw InputError(fmt::format("--linear-rule '{}': expected variance ([SS23] eq. 19) or drop", name));
 }
 
 Estimator parseEstimator(const std::string& name) {
@@ -271,7 +271,7 @@ int main(int argc, char** argv) {
   renderAdaptive.add(renderCmd);
   std::string alphaMap;
   renderCmd->add_option("--alpha-map", alphaMap, "write the per-pixel allocation: EXR here, false-colour PNG beside");
-  renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi (000 eq. 4.1) or one (one-sample MIS)")
+  renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi ([HS14] eq. 4.1) or one (one-sample MIS)")
       ->capture_default_str();
   renderCmd->add_option("--seed", seed, "random seed")->capture_default_str()->check(anyUnsigned64());
   renderCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, an index from `misalloc devices`, or host (C++)")

@@ -2,6 +2,7 @@
 // sin θ per texel, uniform in (φ, θ) inside the texel) and the two samplers with that
 // same pdf: an O(1) alias table and marginal/conditional CDFs with binary searches.
 // Host side: host/scene/Envmap.h, host/scene/EnvmapDistribution.h.
+#include "namespace_check.h"
 #ifndef MA_ENVMAP_H
 #define MA_ENVMAP_H
 #include "common.h"
@@ -17,7 +18,7 @@ typedef struct {
   int width, height;
   int useCdf;
   int cdfStepsRow, cdfStepsCol;  // ceil(log2(H)), ceil(log2(W)): fixed-step binary searches
-  float coskExponent;            // ≥ 0: analytic radiance cos^K θ on the upper hemisphere (000 App. D)
+  float coskExponent;            // ≥ 0: analytic radiance cos^K θ on the upper hemisphere ([HS14] App. D)
 } EnvmapView;
 
 typedef struct {

@@ -239,8 +239,8 @@ MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix)
   for (int k = 0; k < techniqueCount; ++k) stageMix[k] = m > 0.0f ? added.count[k] / m : 0.0f;
 }
 
-// Rule (a), 000 Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
-// V = Σ_j α_j ν_j − μ² (000 eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j (000 eq. 4.16)
+// Rule (a), [HS14] Alg. 1 lines 9–13. With μ = Σ_j α_j μ_j and the one-sample variance
+// V = Σ_j α_j ν_j − μ² ([HS14] eq. 4.4), Λ_j = c_j V − (Σ_k c_k α_k) ν_j ([HS14] eq. 4.16)
 // is the same for every j at the optimum. Score: the entropy of λ_j = Λ_j / Σ_j Λ_j.
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.

@@ -3,13 +3,14 @@
 // kernels/sample.cl and its C++ reference (host/render/HostSampler.cpp). Everything is
 // scalar fields, not arrays: PoCL keeps a kernel scalar that indexes private arrays
 // dynamically.
+#include "namespace_check.h"
 #ifndef MA_PIXEL_H
 #define MA_PIXEL_H
 #include "estimator.h"
 
 typedef struct {
   int techniqueCount, stageSamples, oneSample;
-  int countIndependent;            // 002 eq. 26 instead of the balance heuristic
+  int countIndependent;            // [SHS16] eq. 26 instead of the balance heuristic
   int n0, n1, n2;                  // this stage's counts (one-sample: expected counts)
   ma_uint first0, first1, first2;  // index of each technique's first sample this stage
 } StageCounts;
@@ -50,8 +51,8 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   stageFractions(c, alpha);
   MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
   SampleValue s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
-  // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k (000 eq. 4.2). Count-independent
-  // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) (002 eq. 26).
+  // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent
+  // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) ([SHS16] eq. 26).
   float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
   float mix[MA_MAX_TECHNIQUES];
   MA_UNROLL

@@ -1,4 +1,4 @@
-// One stage of the multi-sample (000 eq. 4.1) or one-sample balance-heuristic
+// One stage of the multi-sample ([HS14] eq. 4.1) or one-sample balance-heuristic
 // estimator for every pixel at once. Host side: host/render/Sampler.h runs it,
 // host/render/HostSampler.cpp is its C++ reference.
 //

@@ -2,13 +2,14 @@
 // (host/alloc/PixelStats.h, which decodes them). A stage adds each sample to the sums
 // of the technique that drew it; MA_STATS chooses which sums a method keeps, so that
 // each method stores only what it reads.
+#include "namespace_check.h"
 #ifndef MA_STATS_H
 #define MA_STATS_H
 #include "pixel.h"
 
-#define MA_STATS_TECHNIQUE 1  // Σ f/p_k and Σ (f/p_k)²: V_k of 000 eq. 4.18 (heuristic)
-#define MA_STATS_BALANCE 2    // Σ f/Σ_l p_l and its square: σ_k of 002 eq. 27–28 (σ/√c)
-#define MA_STATS_LINEAR 4     // F_k = Σ f and P_ik = Σ p_i: 003 eq. 18 (linear)
+#define MA_STATS_TECHNIQUE 1  // Σ f/p_k and Σ (f/p_k)²: V_k of [HS14] eq. 4.18 (heuristic)
+#define MA_STATS_BALANCE 2    // Σ f/Σ_l p_l and its square: σ_k of [SHS16] eq. 27–28 (σ/√c)
+#define MA_STATS_LINEAR 4     // F_k = Σ f and P_ik = Σ p_i: [SS23] eq. 18 (linear)
 
 // Per technique: the count, then the sums that `mask` selects, in the order above; no
 // slot at all when the method keeps no sums. A macro: kernels size local arrays with it.
@@ -41,7 +42,7 @@ MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
   return value;
 }
 
-// Stored samples for the allocations that need every sample: linear with 003 eq. 19
+// Stored samples for the allocations that need every sample: linear with [SS23] eq. 19
 // keeps them all; the grid searches of exact and oracle (kernels/gridsearch.cl) keep
 // running sums and need only those taken since the previous search. Blocked by 16
 // pixels for float16 loads: value q of the pixel's sample in slot i is at

@@ -61,7 +61,7 @@ TEST_CASE("adaptive methods spend exactly the budget of every pixel", "[adaptive
   }
 }
 
-TEST_CASE("adaptive estimates are unbiased against 000 eq. 6.17", "[adaptive][unbiased]") {
+TEST_CASE("adaptive estimates are unbiased against [HS14] eq. 6.17", "[adaptive][unbiased]") {
   // Each pixel of a uniform grid runs its own adaptive schedule on its own samples, so
   // the pixel estimates are independent and the pixel mean has a known standard error.
   struct Case {

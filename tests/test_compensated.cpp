@@ -1,6 +1,6 @@
 // The MIS-compensated envmap pdf ([Kar19] eq. 14): its tables, its fallback on a
 // constant map, the refusal of envmap sampling alone, and the unbiasedness of every
-// method with it against the closed form 000 eq. 6.17. The pdf ∝ max(0, L − 2(1−C)·L̄)
+// method with it against the closed form [HS14] eq. 6.17. The pdf ∝ max(0, L − 2(1−C)·L̄)
 // is zero on most of a cos^K map, so these estimates rest on BRDF sampling there.
 #include <fmt/format.h>
 
@@ -168,7 +168,7 @@ TEST_CASE("the compensated pdf refuses schedules that could skip BRDF sampling",
   CHECK(bad.output.find("must lie in (0, 1]") != std::string::npos);
 }
 
-TEST_CASE("every method is unbiased with the compensated pdf against 000 eq. 6.17", "[compensated][unbiased]") {
+TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 6.17", "[compensated][unbiased]") {
   struct Case {
     double rhoD, n, K;
     const char* pdf;
@@ -259,7 +259,7 @@ TEST_CASE("compare runs each scene with each envmap pdf and compares them with e
   nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
   CHECK(runs["runs"].size() == 2 * 2 * 2 * 2);
   CHECK(runs["cases"][1]["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
-  CHECK(runs["cases"][1]["reference"] == "analytic (000 eq. 6.17)");
+  CHECK(runs["cases"][1]["reference"] == "analytic ([HS14] eq. 6.17)");
 
   auto refused = runMisalloc(fmt::format(
       "compare --envmap cosk:2 --size 8x8 --budgets 10 --envmap-pdfs plain,compensated --out-dir {}", out.string()));

@@ -1,4 +1,4 @@
-// The exact allocation (000 Algorithm 1): kernels/gridsearch.cl on PoCL against its C++
+// The exact allocation ([HS14] Algorithm 1): kernels/gridsearch.cl on PoCL against its C++
 // reference, and both against optima known in closed form or by quadrature.
 #include <fmt/format.h>
 
@@ -107,7 +107,7 @@ double techniquePdf(int k, double x) { return (k + 1) * std::pow(x, k); }
 double sampleTechnique(int k, double u) { return std::pow(u, 1.0 / (k + 1)); }
 
 // n stratified samples per technique (u = (s + ½)/n), techniques interleaved: the
-// estimates of 000 eq. 6.6 and 6.8 then become midpoint quadratures, close to exact.
+// estimates of [HS14] eq. 6.6 and 6.8 then become midpoint quadratures, close to exact.
 PixelSampleList stratified(double (*f)(double), int techniqueCount, int n) {
   PixelSampleList samples;
   for (int s = 0; s < n; ++s)
@@ -143,7 +143,7 @@ std::vector<PixelSampleList> randomPixels(int techniqueCount, int pixelCount, in
 // The weight of technique k at the selected combination.
 double selectedAlpha(const GridSearchResult& r, int k) { return r.allocations.front().alpha[k]; }
 
-// 002 Table 2 (README: "Multi-sample") by quadrature: V(α) = ∫ f²/p_α − Σ_j α_j μ_j²
+// [SHS16] Table 2 (README: "Multi-sample") by quadrature: V(α) = ∫ f²/p_α − Σ_j α_j μ_j²
 // with μ_j = ∫ f p_j / p_α, for N = 1.
 double multiSampleVariance(double (*f)(double), const float* alpha, int techniqueCount) {
   auto mixture = [&](double x) {

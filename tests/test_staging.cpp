@@ -105,7 +105,7 @@ TEST_CASE("splitting every stage by alpha beats approaching alpha*N cumulatively
 }
 
 TEST_CASE("the staged estimator's variance is the sum of its stages' exact variances", "[adaptive][staging]") {
-  // 003 Example 2 (two Gaussians): a pilot of 4 + 4 and one stage of 32 at α = (0.8, 0.2),
+  // [SS23] Example 2 (two Gaussians): a pilot of 4 + 4 and one stage of 32 at α = (0.8, 0.2),
   // combined with weights N_b/N, repeated 20000 times with fixed seeds.
   Example1D example = paperExample("003-2");
   const Schedule schedule{{4, 4}, {26, 6}};

@@ -18,13 +18,13 @@ enum AllocationFallback : unsigned {
   kFallbackSilentTechnique = 1u << 3,   // a technique saw only f = 0: its weight is 0
   kFallbackZeroVariance = 1u << 4,      // a variance estimate is 0: the formula's limit is used
   kFallbackInfiniteVariance = 1u << 5,  // every technique's variance is infinite: equal weights
-  kFallbackSingularSystem = 1u << 6,    // 003 eq. 14 has no unique solution: equal weights over the active set
+  kFallbackSingularSystem = 1u << 6,    // [SS23] eq. 14 has no unique solution: equal weights over the active set
 };
 
 struct Allocation {
   std::vector<double> alpha;  // α_k ≥ 0, Σ α_k = 1
   unsigned fallbacks = kFallbackNone;
-  // Weights the linear heuristic set to 0 by 003 Sec. 5.1. Part of that rule, not a
+  // Weights the linear heuristic set to 0 by [SS23] Sec. 5.1. Part of that rule, not a
   // fallback; counted because a negative raw solution flags a boundary optimum.
   int zeroedWeights = 0;
 

@@ -179,13 +179,13 @@ struct SearchSetup {
 };
 
 // Adds g and g² of each technique's new samples to its sums for every combination l
-// (000 Alg. 1 line 8), the sums at `sums` (runningSumIndex) first brought to the current
+// ([HS14] Alg. 1 line 8), the sums at `sums` (runningSumIndex) first brought to the current
 // scale: the kernel's loadSums, sumTechnique and storeSums as plain loops, with the
 // same operations in the same order.
 // Adds the new samples to the running sums at `sums` (runningSumIndex) for every
 // combination l, the sums first brought to the current scale: the kernel's loadSums,
 // sumTechnique or sumMixture and storeSums as plain loops, with the same operations in
-// the same order. Rule (a): Σ g and Σ g² of each technique's samples (000 Alg. 1 line
+// the same order. Rule (a): Σ g and Σ g² of each technique's samples ([HS14] Alg. 1 line
 // 8); rule (b): M_j and S2 (kernels/gridsearch.h, costVarianceScore).
 template <int M>
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
@@ -268,7 +268,7 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   }
 }
 
-// The best l₀ by the pixel's sums (000 Alg. 1 line 13), −1 if none could be ranked;
+// The best l₀ by the pixel's sums ([HS14] Alg. 1 line 13), −1 if none could be ranked;
 // every combination's score goes to `scores`.
 int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, const float* sums, float* scores) {
   const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
@@ -293,7 +293,7 @@ int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, con
   return best;
 }
 
-// 000 Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it: adds the
+// [HS14] Alg. 1 lines 5–13 for one pixel, as the kernel's gridSearch does it: adds the
 // new samples to `summary` and the running sums at `sums`, then selects, writing the
 // scores and the scale of the sums.
 void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepared, kern::PixelSummary& summary,

@@ -1,5 +1,5 @@
 #pragma once
-// Havran & Sbert's "exact" allocation (000 Sec. 4.2, Algorithm 1): for every pixel,
+// Havran & Sbert's "exact" allocation ([HS14] Sec. 4.2, Algorithm 1): for every pixel,
 // the weight combination out of a grid of U that is best according to the pixel's
 // samples so far, by one of two rules. GridSearch runs kernels/gridsearch.cl on a
 // device; GridSearchReference is its C++ reference and OpenMP peer.
@@ -15,13 +15,13 @@
 
 namespace misalloc {
 
-// How 000 Alg. 1 line 13 picks the combination l₀.
+// How [HS14] Alg. 1 line 13 picks the combination l₀.
 enum class GridRule {
   // As written: the l whose λ_{j,l} = Λ_{j,l} / Σ_j Λ_{j,l} (eq. 4.16) has maximum
   // entropy, i.e. is closest to the equal Λ_j of the optimum.
   MaxEntropy,
   // The l with the least estimated cost × variance of the estimator actually used:
-  // (Σ_k c_k α_k) · Σ_j α_j (ν_j − μ_j²), the multi-sample balance heuristic (002 eq. 21).
+  // (Σ_k c_k α_k) · Σ_j α_j (ν_j − μ_j²), the multi-sample balance heuristic ([SHS16] eq. 21).
   MinCostVariance,
 };
 
@@ -30,7 +30,7 @@ enum class GridRule {
 // M = 3 within 2.7 % (tests/test_exact.cpp), below the noise of a pixel's estimates.
 inline constexpr int kDefaultGridSize = 80;
 
-// The U weight combinations of 000 Alg. 1 line 4, every α_k > 0. For a lattice
+// The U weight combinations of [HS14] Alg. 1 line 4, every α_k > 0. For a lattice
 // resolution r they are α_k = (a_k + 1/M) / (r + 1) over the integer a ≥ 0 with
 // Σ_k a_k = r: C(r + M − 1, M − 1) points, r chosen to make that closest to the
 // requested size (exactly U for M = 2, where α_0 = (l + ½)/U).

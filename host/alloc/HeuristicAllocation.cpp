@@ -14,7 +14,7 @@ double harmonicMean(const std::vector<double>& values) {
 
 namespace {
 
-// 000 Sec. 4.3, V_k → 0: the zero-variance techniques take all the weight.
+// [HS14] Sec. 4.3, V_k → 0: the zero-variance techniques take all the weight.
 Allocation zeroVarianceLimit(const std::vector<double>& variances, const std::vector<double>& costs) {
   Allocation a{std::vector<double>(variances.size(), 0.0), kFallbackZeroVariance};
   double norm = 0;
@@ -43,7 +43,7 @@ Allocation heuristicWeights(const std::vector<double>& variances, const std::vec
   for (int k = 0; k < m; ++k) costVariance[k] = costs[k] * variances[k];
   double h = harmonicMean(costVariance);
   Allocation a{std::vector<double>(m)};
-  for (int k = 0; k < m; ++k) a.alpha[k] = h / (m * costVariance[k]);  // 000 eq. 4.20
+  for (int k = 0; k < m; ++k) a.alpha[k] = h / (m * costVariance[k]);  // [HS14] eq. 4.20
   return a;
 }
 
@@ -61,7 +61,7 @@ Allocation allocateHeuristic(const PixelStats& stats, const std::vector<double>&
       continue;
     }
     double mean = t.sumW / t.count;
-    double v = sampleVariance(t.sumW, t.sumW2, t.count);  // 000 eq. 6.19
+    double v = sampleVariance(t.sumW, t.sumW2, t.count);  // [HS14] eq. 6.19
     variances[k] = isZeroVariance(v, mean) ? 0 : v;
   }
   Allocation a = heuristicWeights(variances, costs);

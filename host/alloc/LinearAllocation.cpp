@@ -109,7 +109,7 @@ Allocation minSampleVariance(const PixelSamples& samples, unsigned mask, unsigne
       std::optional<std::vector<double>> alpha = solveActiveSet(stats, subset);
       if (!alpha || !isFeasible(*alpha)) continue;
       std::vector<double> clamped = clampToSimplex(*alpha);
-      double variance = mixtureSampleVariance(samples, clamped);  // 003 eq. 19
+      double variance = mixtureSampleVariance(samples, clamped);  // [SS23] eq. 19
       if (!best || variance < bestVariance) {
         best = clamped;
         bestVariance = variance;
@@ -123,12 +123,12 @@ Allocation minSampleVariance(const PixelSamples& samples, unsigned mask, unsigne
 }  // namespace
 
 std::optional<double> linearPairWeight(const PixelStats& stats, int i, int j) {
-  // P[a][b] = P_ab = Σ_l p_a(X_bl): pdf a at the samples of technique b (003 eq. 18).
+  // P[a][b] = P_ab = Σ_l p_a(X_bl): pdf a at the samples of technique b ([SS23] eq. 18).
   const TechniqueStats& ti = stats.technique[i];
   const TechniqueStats& tj = stats.technique[j];
   double pii = ti.sumPdf[i], pji = ti.sumPdf[j], pij = tj.sumPdf[i], pjj = tj.sumPdf[j];
   double fi = ti.sumF, fj = tj.sumF;
-  double denominator = pii * fj - pji * fj - pij * fi + pjj * fi;  // 003 eq. 17
+  double denominator = pii * fj - pji * fj - pij * fi + pjj * fi;  // [SS23] eq. 17
   double alpha = (pjj * fi - pji * fj) / denominator;
   if (denominator == 0 || !std::isfinite(alpha)) return std::nullopt;
   return alpha;
@@ -142,7 +142,7 @@ std::optional<std::vector<double>> solveLinearSystem(const PixelStats& stats, un
   int n = static_cast<int>(active.size());
 
   // Unknowns (α_active..., 1/μ). Row r: Σ_i α_i P_ik / F_k − 1/μ = 0 for k = active[r]
-  // (003 eq. 14); last row: Σ_i α_i = 1.
+  // ([SS23] eq. 14); last row: Σ_i α_i = 1.
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n + 1, n + 1);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n + 1);
   for (int r = 0; r < n; ++r) {

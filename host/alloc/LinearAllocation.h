@@ -1,6 +1,6 @@
 #pragma once
-// Szirmay-Kalos & Sbert's linear heuristic (003 Sec. 5): weights from a linear
-// equation in the running sums P_ik and F_k of 003 eq. 18.
+// Szirmay-Kalos & Sbert's linear heuristic ([SS23] Sec. 5): weights from a linear
+// equation in the running sums P_ik and F_k of [SS23] eq. 18.
 
 #include <optional>
 #include <vector>
@@ -10,18 +10,18 @@
 
 namespace misalloc {
 
-// 003 Sec. 5.1: what to do when eq. 14's solution has a negative weight.
+// [SS23] Sec. 5.1: what to do when eq. 14's solution has a negative weight.
 enum class ZeroWeightRule {
   DropMostNegative,   // first technique: zero the most negative weight, re-solve, repeat
   MinSampleVariance,  // second technique: zero each weight in turn (then pairs, ...) and keep
                       // the feasible solution with the smallest sample variance (eq. 19)
 };
 
-// 003 eq. 17 for the techniques i, j alone: α_i, with α_j = 1 − α_i. nullopt if the
+// [SS23] eq. 17 for the techniques i, j alone: α_i, with α_j = 1 − α_i. nullopt if the
 // denominator vanishes, i.e. eq. 15 does not determine α.
 std::optional<double> linearPairWeight(const PixelStats& stats, int i, int j);
 
-// 003 eq. 14 for the techniques whose bit is set in activeMask (the others weigh 0):
+// [SS23] eq. 14 for the techniques whose bit is set in activeMask (the others weigh 0):
 // Σ_i α_i P_ik / F_k = 1/μ for every active k, Σ_i α_i = 1, solved for α and 1/μ as
 // one dense system. Needs F_k > 0 for active k. nullopt if the system is singular.
 // Weights may come out negative; that is for the Sec. 5.1 rules to handle.

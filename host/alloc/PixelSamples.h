@@ -1,6 +1,6 @@
 #pragma once
 // Every sample of one pixel, kept per technique, for the estimator that needs more
-// than running sums: the sample variance of 003 eq. 19.
+// than running sums: the sample variance of [SS23] eq. 19.
 
 #include <vector>
 
@@ -29,8 +29,8 @@ class PixelSamples {
   std::vector<StoredSample> samples_[kMaxTechniques];
 };
 
-// 003 eq. 19: the sample estimate of the multi-sample balance-heuristic variance
-// V[F] = Σ_i α_i σ_i² (003 eq. 3) at weights alpha. Techniques with α_i = 0 contribute
+// [SS23] eq. 19: the sample estimate of the multi-sample balance-heuristic variance
+// V[F] = Σ_i α_i σ_i² ([SS23] eq. 3) at weights alpha. Techniques with α_i = 0 contribute
 // nothing. Returns +∞ if a sample of a technique with α_i > 0 has p_α = 0 and f ≠ 0.
 double mixtureSampleVariance(const PixelSamples& samples, const std::vector<double>& alpha);
 

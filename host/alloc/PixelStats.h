@@ -3,22 +3,22 @@
 
 namespace misalloc {
 
-// The largest M any rule supports: 003's Example 5 combines four techniques.
+// The largest M any rule supports: [SS23]'s Example 5 combines four techniques.
 inline constexpr int kMaxTechniques = 4;
 
 // Sums over the samples X_kj drawn from one technique k. Every field is a double so
 // the struct is a flat block of doubles that a kernel can accumulate in place.
 struct TechniqueStats {
   double count = 0;                    // n_k
-  double sumW = 0;                     // Σ w, w = f / p_k: the single-technique estimator of 000 eq. 4.18
+  double sumW = 0;                     // Σ w, w = f / p_k: the single-technique estimator of [HS14] eq. 4.18
   double sumW2 = 0;                    // Σ w²
-  double sumBalance = 0;               // Σ b, b = f / Σ_l p_l: the F_ij of 002 eq. 27
+  double sumBalance = 0;               // Σ b, b = f / Σ_l p_l: the F_ij of [SHS16] eq. 27
   double sumBalance2 = 0;              // Σ b²
-  double sumF = 0;                     // F_k = Σ_j f(X_kj) (003 eq. 18)
-  double sumPdf[kMaxTechniques] = {};  // sumPdf[i] = P_ik = Σ_j p_i(X_kj) (003 eq. 18)
+  double sumF = 0;                     // F_k = Σ_j f(X_kj) ([SS23] eq. 18)
+  double sumPdf[kMaxTechniques] = {};  // sumPdf[i] = P_ik = Σ_j p_i(X_kj) ([SS23] eq. 18)
 };
 
-// 000 eq. 6.19: the unbiased sample variance from running sums. Cancellation in
+// [HS14] eq. 6.19: the unbiased sample variance from running sums. Cancellation in
 // Σg² − (Σg)²/n can leave a tiny negative number, which is reported as 0.
 double sampleVariance(double sum, double sumSquares, double count);
 

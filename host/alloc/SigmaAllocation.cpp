@@ -13,7 +13,7 @@ Allocation sigmaSqrtCWeights(const std::vector<double>& sigmas, const std::vecto
   for (int i = 0; i < m; ++i) {
     if (!(std::isfinite(sigmas[i]) && sigmas[i] >= 0))
       throw std::invalid_argument("sigmaSqrtCWeights: sigma must be finite and >= 0");
-    share[i] = sigmas[i] / std::sqrt(costs[i]);  // 002 eq. 31
+    share[i] = sigmas[i] / std::sqrt(costs[i]);  // [SHS16] eq. 31
     total += share[i];
   }
   if (total == 0) return equalFallback(m, kFallbackZeroVariance);
@@ -32,7 +32,7 @@ Allocation allocateSigmaSqrtC(const PixelStats& stats, const std::vector<double>
     const TechniqueStats& t = stats.technique[i];
     if (isSilent(t)) fallbacks |= kFallbackSilentTechnique;
     double mean = t.sumBalance / t.count;
-    double v = sampleVariance(t.sumBalance, t.sumBalance2, t.count);  // 000 eq. 6.19
+    double v = sampleVariance(t.sumBalance, t.sumBalance2, t.count);  // [HS14] eq. 6.19
     sigmas[i] = isZeroVariance(v, mean) ? 0 : std::sqrt(v);
   }
   Allocation a = sigmaSqrtCWeights(sigmas, costs);

@@ -168,7 +168,7 @@ std::string summaryMarkdown(const Summary& s) {
         first->info.device, fmt::join(s.budgets, ", "), repeats);
   }
   out += fmt::format(
-      "## RMSE×1000 at {} spp\n\nThe layout of 000 Table 5.2: the RMSE of RGB over the image against the reference, "
+      "## RMSE×1000 at {} spp\n\nThe layout of [HS14] Table 5.2: the RMSE of RGB over the image against the reference, "
       "×1000, as the mean over repeats ± their spread (sample standard deviation). Bold: the best of the column.\n\n",
       s.tableBudget);
   out += markdown(rmseTable(s));

@@ -21,7 +21,7 @@ struct TextTable {
 std::string markdown(const TextTable& table);
 std::string html(const TextTable& table);
 
-// Rows = methods, columns = scenes (000 Table 5.2): RMSE×1000 at the table budget as
+// Rows = methods, columns = scenes ([HS14] Table 5.2): RMSE×1000 at the table budget as
 // mean ± spread; the speed-up over equal at equal error at one budget; the time per
 // render.
 TextTable rmseTable(const Summary& summary);
@@ -33,7 +33,7 @@ TextTable timeTable(const Summary& summary);
 // One scene: each method's RMSE×1000 at equal's render times (ErrorCurve::mseAt).
 TextTable equalTimeTable(const CaseSummary& scene);
 
-// The summary in the layout of 000 Table 5.2 (rows = methods, columns = scenes):
+// The summary in the layout of [HS14] Table 5.2 (rows = methods, columns = scenes):
 // RMSE×1000 at the table budget, then the speed-up over equal at equal error and the
 // time per render; per scene, the equal-time errors.
 std::string summaryMarkdown(const Summary& summary);

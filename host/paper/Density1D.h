@@ -13,7 +13,7 @@ class Density1D {
  public:
   // p = h / ∫_a^b h, the integral computed by adaptive quadrature.
   Density1D(std::string name, Function1D shape, double a, double b);
-  // p = h / s with s given: 000 App. C rounds ∫(x² − x/π) to 8.764 and uses that.
+  // p = h / s with s given: [HS14] App. C rounds ∫(x² − x/π) to 8.764 and uses that.
   Density1D(std::string name, Function1D shape, double a, double b, double normalisation);
 
   double operator()(double x) const { return shape_(x) / normalisation_; }
@@ -29,13 +29,13 @@ class Density1D {
   double a_, b_, normalisation_;
 };
 
-// 000 eq. 4.3: the mixture p_α(x) = Σ_k α_k p_k(x), the density of balance-heuristic MIS.
+// [HS14] eq. 4.3: the mixture p_α(x) = Σ_k α_k p_k(x), the density of balance-heuristic MIS.
 double mixturePdf(const std::vector<Density1D>& pdfs, const std::vector<double>& alpha, double x);
 
 // φ_{m,σ}(x), the normal density, as 003 writes its integrands.
 double normalPdf(double x, double mean, double sigma);
 
-// φ_{m,σ} truncated to [a, b] and renormalised there, as 003's Gaussian pdfs have to be
+// φ_{m,σ} truncated to [a, b] and renormalised there, as [SS23]'s Gaussian pdfs have to be
 // to sample its bounded domains.
 Density1D truncatedGaussian(double mean, double sigma, double a, double b);
 

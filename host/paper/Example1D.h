@@ -28,7 +28,7 @@ class Example1D {
   // I = ∫_a^b f.
   double integral() const { return integral_; }
 
-  // 000 eq. 4.3: p_α(x) = Σ_k α_k p_k(x).
+  // [HS14] eq. 4.3: p_α(x) = Σ_k α_k p_k(x).
   double mixturePdf(const std::vector<double>& alpha, double x) const;
   VarianceStatus classify(const std::vector<double>& alpha) const { return check_.classify(alpha); }
   std::optional<std::vector<double>> mostViolatedProbe(const std::vector<double>& alpha) const {

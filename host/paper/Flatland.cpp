@@ -151,7 +151,7 @@ std::vector<double> FlatlandStudy::pdfAtNodes(FlatlandPdf pdf) const {
 }
 
 // One-sample: ∫ f²/p_eff − F² with p_eff = c p_I + (1−c) p_ρ ([Kar19] eq. 4). Multi-sample
-// with fixed counts c, 1−c: ∫ f²/p_eff − Σ_i μ_i²/c_i, μ_i = ∫ c_i p_i f / p_eff (002 Table 2).
+// with fixed counts c, 1−c: ∫ f²/p_eff − Σ_i μ_i²/c_i, μ_i = ∫ c_i p_i f / p_eff ([SHS16] Table 2).
 FlatlandVariance FlatlandStudy::varianceOf(const std::vector<double>& hdrPdf, double c) const {
   double second = 0, muHdr = 0, muBrdf = 0;
   for (size_t n = 0; n < t_.size(); ++n) {

@@ -12,7 +12,7 @@ namespace misalloc {
 class InverseCdfSampler {
  public:
   // Throws std::domain_error if the shape is negative anywhere it is probed: such a
-  // "density" cannot be sampled (000 App. C's x² − x/π on [0, 1/π]).
+  // "density" cannot be sampled ([HS14] App. C's x² − x/π on [0, 1/π]).
   explicit InverseCdfSampler(const Density1D& density);
 
   // The point x with CDF(x) = u, for u in [0, 1).

@@ -9,8 +9,8 @@
 namespace misalloc {
 
 enum class VarianceModel {
-  OneSample,    // 002 eq. 35: the technique of each sample is drawn with probabilities α
-  MultiSample,  // 002 eq. 21: deterministic counts n_k = α_k N
+  OneSample,    // [SHS16] eq. 35: the technique of each sample is drawn with probabilities α
+  MultiSample,  // [SHS16] eq. 21: deterministic counts n_k = α_k N
 };
 
 VarianceValue mixtureVariance(const Example1D& example, VarianceModel model, const std::vector<double>& alpha);
@@ -24,10 +24,10 @@ struct OptimalMixture {
 
 // Minimises (Σ_k c_k α_k)·V(α) over the simplex by the nonmonotone spectral projected
 // gradient method (Birgin, Martínez & Raydan 2000), from equal weights, with exact
-// gradients: ∂V/∂α_j = −E_j for one sample (000 eq. 4.7) and, differentiating
+// gradients: ∂V/∂α_j = −E_j for one sample ([HS14] eq. 4.7) and, differentiating
 // λ − Σ_i α_i m_i², −E_j − m_j² + 2 Σ_i α_i m_i B_ij for multi-sample. Steps that
 // would leave the valid densities with finite variance are shortened, so an optimum on
-// the edge of validity (000 App. C) is approached from inside.
+// the edge of validity ([HS14] App. C) is approached from inside.
 OptimalMixture minimiseInefficiency(const Example1D& example, VarianceModel model, const std::vector<double>& costs);
 
 struct GridMinimum {

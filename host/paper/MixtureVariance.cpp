@@ -19,7 +19,7 @@ MixtureMoments filledMoments(VarianceStatus status, int m, double value, bool wi
                         std::vector<double>(withCrossMoments ? m * m : 0, value)};
 }
 
-// Σ_i μ_i²/α_i = Σ_i α_i m_i², the term 002 eq. 21 subtracts; 0 for α_i = 0.
+// Σ_i μ_i²/α_i = Σ_i α_i m_i², the term [SHS16] eq. 21 subtracts; 0 for α_i = 0.
 double weightedMeanSquares(const MixtureMoments& moments, const std::vector<double>& alpha) {
   double sum = 0;
   for (std::size_t i = 0; i < alpha.size(); ++i)

@@ -74,13 +74,13 @@ std::string allocationRuleName(AllocationRule rule) {
     case AllocationRule::Equal:
       return "equal";
     case AllocationRule::Heuristic:
-      return "heuristic (000 eq. 4.20)";
+      return "heuristic ([HS14] eq. 4.20)";
     case AllocationRule::SigmaSqrtC:
-      return "sigma/sqrt(c) (002 eq. 31)";
+      return "sigma/sqrt(c) ([SHS16] eq. 31)";
     case AllocationRule::LinearDropMostNegative:
-      return "linear, drop most negative (003)";
+      return "linear, drop most negative ([SS23])";
     case AllocationRule::LinearMinSampleVariance:
-      return "linear, min sample variance (003)";
+      return "linear, min sample variance ([SS23])";
   }
   return "";
 }

@@ -14,10 +14,10 @@ namespace misalloc {
 
 enum class AllocationRule {
   Equal,                    // α = 1/M
-  Heuristic,                // 000 eq. 4.20
-  SigmaSqrtC,               // 002 eq. 31
-  LinearDropMostNegative,   // 003 eq. 14, Sec. 5.1 first technique
-  LinearMinSampleVariance,  // 003 eq. 14, Sec. 5.1 second technique
+  Heuristic,                // [HS14] eq. 4.20
+  SigmaSqrtC,               // [SHS16] eq. 31
+  LinearDropMostNegative,   // [SS23] eq. 14, Sec. 5.1 first technique
+  LinearMinSampleVariance,  // [SS23] eq. 14, Sec. 5.1 second technique
 };
 
 std::vector<AllocationRule> allAllocationRules();
@@ -37,14 +37,14 @@ struct RuleOutcome {
   AllocationRule rule;
   std::vector<double> meanAlpha;
   // Over the runs: (Σ_k c_k α_k)·V(α) with the example's costs and V the exact N = 1
-  // variance of the estimator the rule allocates for: 002 eq. 29 (count-independent
-  // weights) for SigmaSqrtC, the multi-sample balance heuristic (002 eq. 21) otherwise.
+  // variance of the estimator the rule allocates for: [SHS16] eq. 29 (count-independent
+  // weights) for SigmaSqrtC, the multi-sample balance heuristic ([SHS16] eq. 21) otherwise.
   Quantiles inefficiency;
   int fallbackRuns;  // runs in which the rule used a fallback
-  int boundaryRuns;  // runs in which 003 Sec. 5.1 set a weight to 0
+  int boundaryRuns;  // runs in which [SS23] Sec. 5.1 set a weight to 0
 };
 
-// Throws std::domain_error if a technique's "density" cannot be sampled (000 App. C).
+// Throws std::domain_error if a technique's "density" cannot be sampled ([HS14] App. C).
 std::vector<RuleOutcome> runAllocationStudy(const Example1D& example, const StudyConfig& config);
 
 }  // namespace misalloc

@@ -11,7 +11,7 @@ namespace misalloc {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-const std::vector<double> kHavranSbertCosts = {1, 6.24, 3.28};  // 000 App. C, measured in C++
+const std::vector<double> kHavranSbertCosts = {1, 6.24, 3.28};  // [HS14] App. C, measured in C++
 
 double parabola(double x) { return x * x - x / kPi; }  // h₂ = x² − x/π
 
@@ -37,7 +37,7 @@ Example1D example000AppendixC(AppendixCNormalisation normalisation) {
   std::vector<Density1D> pdfs = productTechniques(a, b);
   if (normalisation == AppendixCNormalisation::AsPrinted)
     pdfs[1] = Density1D("(x^2-x/pi)/8.764", parabola, a, b, 8.764);
-  return Example1D("000-C", "000 App. C: f = x (x^2 - x/pi) sin x on [0, pi]; techniques x, x^2 - x/pi, sin x", a, b,
+  return Example1D("000-C", "[HS14] App. C: f = x (x^2 - x/pi) sin x on [0, pi]; techniques x, x^2 - x/pi, sin x", a, b,
                    productIntegrand, pdfs, kHavranSbertCosts);
 }
 
@@ -59,7 +59,7 @@ Example1D example002(int number) {
       integrand = "x + (x^2 - x/pi) + sin x";
       break;
     case 4:
-      // 002 eq. 55 divides by the printed constants, 8.764 included.
+      // [SHS16] eq. 55 divides by the printed constants, 8.764 included.
       f = [](double x) { return x / 4.82082 + parabola(x) / 8.764 + std::sin(x) / 1.88816; };
       integrand = "x/4.82082 + (x^2 - x/pi)/8.764 + sin x/1.88816";
       break;
@@ -67,7 +67,7 @@ Example1D example002(int number) {
       throw unknownExample(fmt::format("002-{}", number));
   }
   return Example1D(fmt::format("002-{}", number),
-                   fmt::format("002 App. A, Example {}: f = {} on [3/(2pi), pi]; techniques x, x^2 - x/pi, sin x",
+                   fmt::format("[SHS16] App. A, Example {}: f = {} on [3/(2pi), pi]; techniques x, x^2 - x/pi, sin x",
                                number, integrand),
                    a, b, f, productTechniques(a, b), kHavranSbertCosts);
 }
@@ -130,7 +130,7 @@ Example1D example003(int number) {
   std::vector<std::string> names;
   for (const Density1D& p : pdfs) names.push_back(p.name());
   return Example1D(fmt::format("003-{}", number),
-                   fmt::format("003 Sec. 6.1, Example {}: f = {}; pdfs {}", number, integrand, fmt::join(names, ", ")),
+                   fmt::format("[SS23] Sec. 6.1, Example {}: f = {}; pdfs {}", number, integrand, fmt::join(names, ", ")),
                    a, b, f, pdfs, std::vector<double>(pdfs.size(), 1.0));
 }
 

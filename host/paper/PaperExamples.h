@@ -8,20 +8,20 @@
 
 namespace misalloc {
 
-// 000 App. C prints ∫_0^π (x² − x/π) dx = 8.764 (truncated from 8.764629) and uses that
+// [HS14] App. C prints ∫_0^π (x² − x/π) dx = 8.764 (truncated from 8.764629) and uses that
 // value in its first block of numbers; its cost block uses the exact one.
 enum class AppendixCNormalisation { AsPrinted, Exact };
 
-// 000 App. C: f = x (x² − x/π) sin x on [0, π], techniques ∝ x, x² − x/π, sin x with
+// [HS14] App. C: f = x (x² − x/π) sin x on [0, π], techniques ∝ x, x² − x/π, sin x with
 // costs 1, 6.24, 3.28. x² − x/π is negative on (0, 1/π): technique 2 is not a density.
 Example1D example000AppendixC(AppendixCNormalisation normalisation);
 
-// 002 App. A, Examples 1–4: the same techniques on [3/(2π), π], where all three are
+// [SHS16] App. A, Examples 1–4: the same techniques on [3/(2π), π], where all three are
 // densities, with f = x (x² − x/π) sin x, (x² − x/π) sin² x, x + (x² − x/π) + sin x, and
 // the sum of the three densities written with the printed constants.
 Example1D example002(int number);
 
-// 003 Sec. 6.1, Examples 1–6, with the integrand of each example as mapped in
+// [SS23] Sec. 6.1, Examples 1–6, with the integrand of each example as mapped in
 // verified_values.json (the extracted text prints every integral one example late).
 // Gaussian pdfs are truncated to the domain and renormalised.
 Example1D example003(int number);

@@ -187,7 +187,7 @@ Values values003(int n) {
 // [Kar19] Sec. 6.3, on map A (paper/Flatland.h).
 constexpr const char* kFlatlandId = "001-6.3";
 constexpr const char* kFlatlandTitle =
-    "001 Sec. 6.3: flatland MIS compensation, HDR map x diffuse or sharp BRDF, c = 0.5 (map A of "
+    "[Kar19] Sec. 6.3: flatland MIS compensation, HDR map x diffuse or sharp BRDF, c = 0.5 (map A of "
     "verified_values.json stands in for the paper's)";
 
 Values values001Flatland() {
@@ -254,7 +254,7 @@ void printStudy(const Example1D& example, std::ostream& out) {
   out << fmt::format(
       "\n  Monte Carlo: {} runs of {} samples per technique (seed {}); every rule allocates from the same samples.\n"
       "  Cost x exact variance (N = 1) at the rule's alpha, for the balance heuristic with fixed counts\n"
-      "  (002 eq. 21), or for sigma/sqrt(c) the count-independent estimator it allocates for (002 eq. 29):\n",
+      "  ([SHS16] eq. 21), or for sigma/sqrt(c) the count-independent estimator it allocates for ([SHS16] eq. 29):\n",
       kStudy.runs, kStudy.samplesPerTechnique, kStudy.seed);
   std::vector<RuleOutcome> outcomes;
   try {

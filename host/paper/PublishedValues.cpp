@@ -11,23 +11,23 @@ constexpr const char* kCorrect = "correct";
 constexpr const char* kTruncated = "correct (truncated, not rounded)";
 constexpr const char* kNotInPaper = "not in the paper";
 
-const char* const k000C = "000 App. C";
-const char* const k001Flatland = "001 Sec. 6.3";
+const char* const k000C = "[HS14] App. C";
+const char* const k001Flatland = "[Kar19] Sec. 6.3";
 constexpr const char* kMapUnknown = "not reproducible (map unknown); same order of magnitude";
-const char* const k002Ex[] = {"", "002 App. A, Ex. 1", "002 App. A, Ex. 2", "002 App. A, Ex. 3", "002 App. A, Ex. 4"};
+const char* const k002Ex[] = {"", "[SHS16] App. A, Ex. 1", "[SHS16] App. A, Ex. 2", "[SHS16] App. A, Ex. 3", "[SHS16] App. A, Ex. 4"};
 
-// The three tables of 002 App. A hold one row per example.
+// The three tables of [SHS16] App. A hold one row per example.
 std::vector<PublishedValue> tables002(const char* v1n, const char* vHeur, const char* eq44_1n, const char* eq44Heur,
                                       const char* t4_1n, const char* t4Heur, const char* t5Sigma, const char* t5Equal,
                                       std::vector<const char*> verdicts) {
-  return {{"Table 3: V at alpha = 1/n", v1n, "002 Table 3", verdicts[0]},
-          {"Table 3: V at alpha ~ 1/V[G]", vHeur, "002 Table 3", verdicts[1]},
-          {"Table 3: eq. 44 at alpha = 1/n", eq44_1n, "002 Table 3", verdicts[2]},
-          {"Table 3: eq. 44 at alpha ~ 1/V[G]", eq44Heur, "002 Table 3", verdicts[3]},
-          {"Table 4: cost x V at alpha = 1/n", t4_1n, "002 Table 4", verdicts[4]},
-          {"Table 4: cost x V at alpha ~ 1/(cV)", t4Heur, "002 Table 4", verdicts[5]},
-          {"Table 5: cost x V, n ~ sigma/sqrt(c)", t5Sigma, "002 Table 5", verdicts[6]},
-          {"Table 5: cost x V, equal count", t5Equal, "002 Table 5", verdicts[7]}};
+  return {{"Table 3: V at alpha = 1/n", v1n, "[SHS16] Table 3", verdicts[0]},
+          {"Table 3: V at alpha ~ 1/V[G]", vHeur, "[SHS16] Table 3", verdicts[1]},
+          {"Table 3: eq. 44 at alpha = 1/n", eq44_1n, "[SHS16] Table 3", verdicts[2]},
+          {"Table 3: eq. 44 at alpha ~ 1/V[G]", eq44Heur, "[SHS16] Table 3", verdicts[3]},
+          {"Table 4: cost x V at alpha = 1/n", t4_1n, "[SHS16] Table 4", verdicts[4]},
+          {"Table 4: cost x V at alpha ~ 1/(cV)", t4Heur, "[SHS16] Table 4", verdicts[5]},
+          {"Table 5: cost x V, n ~ sigma/sqrt(c)", t5Sigma, "[SHS16] Table 5", verdicts[6]},
+          {"Table 5: cost x V, equal count", t5Equal, "[SHS16] Table 5", verdicts[7]}};
 }
 
 std::vector<PublishedValue> concat(std::vector<PublishedValue> a, const std::vector<PublishedValue>& b) {
@@ -66,11 +66,11 @@ const std::map<std::string, std::vector<PublishedValue>>& allPublishedValues() {
         {"relative efficiency, equal cost", "1.2947", k000C, "correct: V(1/3, 1/3, 1/3) / V(alpha), exact s2"},
         {"relative efficiency, with costs", "2.06141", k000C,
          "correct: [mean(c) V(1/3, 1/3, 1/3)] / [(sum c alpha) V(alpha)], exact s2"},
-        {"alpha in Fig. 4.1", "(0.391, 0.520, 0.089)", "000 Fig. 4.1",
+        {"alpha in Fig. 4.1", "(0.391, 0.520, 0.089)", "[HS14] Fig. 4.1",
          "not reproducible (probably a pilot-sample estimate); eq. 4.17 gives ours"},
-        {"Fig. 4.1 caption: efficiency gain (%)", "138", "000 Fig. 4.1",
+        {"Fig. 4.1 caption: efficiency gain (%)", "138", "[HS14] Fig. 4.1",
          "wrong: App. D's gain copied into this caption"},
-        {"Sec. 5.1: efficiency gain (%)", "29", "000 Sec. 5.1",
+        {"Sec. 5.1: efficiency gain (%)", "29", "[HS14] Sec. 5.1",
          "consistent: the paper's value comes from one run of 1000 samples with 200 pilot samples"},
         {"minimum of V over valid mixtures", nullptr, k000C,
          "not in the paper: on the positivity edge p'(0) = 0 (s2 = 8.764)"},
@@ -147,37 +147,37 @@ const std::map<std::string, std::vector<PublishedValue>>& allPublishedValues() {
         {"sharp, one-sample: MIS-compensated vs MIS", "4809", k001Flatland, kMapUnknown},
         {"int (p_comp - p_opt)^2 / int p_opt^2 (diffuse, sharp)", "< 1e-5", k001Flatland,
          "map dependent (the paper's metric is not specified)"},
-        {"lambda in [c F^2, F^2/c], eq. 10 (diffuse, sharp)", "holds", "001 eq. 10", kCorrect}}},
+        {"lambda in [c F^2, F^2/c], eq. 10 (diffuse, sharp)", "holds", "[Kar19] eq. 10", kCorrect}}},
       {"003-1",
-       {{"integral", "25.3065", "003 eq. 20", "correct; printed under Example 2"},
-        {"V, equal budget", "24.1152", "003 Ex. 1", kCorrect},
-        {"V minimum", nullptr, "003 Fig. 4", kNotInPaper},
-        {"alpha at minimum", nullptr, "003 Fig. 4", kNotInPaper}}},
+       {{"integral", "25.3065", "[SS23] eq. 20", "correct; printed under Example 2"},
+        {"V, equal budget", "24.1152", "[SS23] Ex. 1", kCorrect},
+        {"V minimum", nullptr, "[SS23] Fig. 4", kNotInPaper},
+        {"alpha at minimum", nullptr, "[SS23] Fig. 4", kNotInPaper}}},
       {"003-2",
-       {{"integral", "2.9929", "003 eq. 21", "correct; printed under Example 3"},
-        {"V, equal budget", "0.1134", "003 Ex. 2", kCorrect},
-        {"V minimum", nullptr, "003 Fig. 7", "not in the paper: f is a mixture of the two pdfs, zero variance"},
-        {"alpha at minimum", nullptr, "003 Fig. 7", kNotInPaper}}},
+       {{"integral", "2.9929", "[SS23] eq. 21", "correct; printed under Example 3"},
+        {"V, equal budget", "0.1134", "[SS23] Ex. 2", kCorrect},
+        {"V minimum", nullptr, "[SS23] Fig. 7", "not in the paper: f is a mixture of the two pdfs, zero variance"},
+        {"alpha at minimum", nullptr, "[SS23] Fig. 7", kNotInPaper}}},
       {"003-3",
-       {{"integral", "2.3118", "003 eq. 22", "correct; printed under Example 4"},
-        {"V, equal budget", "0.2772", "003 Ex. 3", kCorrect},
-        {"V minimum", nullptr, "003 Fig. 10", kNotInPaper},
-        {"alpha at minimum", nullptr, "003 Fig. 10", kNotInPaper}}},
+       {{"integral", "2.3118", "[SS23] eq. 22", "correct; printed under Example 4"},
+        {"V, equal budget", "0.2772", "[SS23] Ex. 3", kCorrect},
+        {"V minimum", nullptr, "[SS23] Fig. 10", kNotInPaper},
+        {"alpha at minimum", nullptr, "[SS23] Fig. 10", kNotInPaper}}},
       {"003-4",
-       {{"integral", "5.8394", "003 eq. 23", "correct; printed under Example 5"},
-        {"V, equal budget", "6.8063", "003 Ex. 4", kCorrect},
-        {"V minimum", "3.0454", "003 Ex. 4", kCorrect},
-        {"alpha at minimum", nullptr, "003 Ex. 4", kNotInPaper}}},
+       {{"integral", "5.8394", "[SS23] eq. 23", "correct; printed under Example 5"},
+        {"V, equal budget", "6.8063", "[SS23] Ex. 4", kCorrect},
+        {"V minimum", "3.0454", "[SS23] Ex. 4", kCorrect},
+        {"alpha at minimum", nullptr, "[SS23] Ex. 4", kNotInPaper}}},
       {"003-5",
-       {{"integral", "12.7484", "003 eq. 24", kCorrect},
-        {"V, equal budget", "14.4033", "003 Ex. 5", kCorrect},
-        {"V minimum", "1.7217", "003 Ex. 5", kCorrect},
-        {"alpha at minimum", nullptr, "003 Ex. 5", kNotInPaper}}},
+       {{"integral", "12.7484", "[SS23] eq. 24", kCorrect},
+        {"V, equal budget", "14.4033", "[SS23] Ex. 5", kCorrect},
+        {"V minimum", "1.7217", "[SS23] Ex. 5", kCorrect},
+        {"alpha at minimum", nullptr, "[SS23] Ex. 5", kNotInPaper}}},
       {"003-6",
-       {{"integral", "3.5962", "003 eq. 25", "correct up to double rounding (002 prints 3.59615)"},
-        {"V, equal budget", "4.9175", "003 Ex. 6", kTruncated},
-        {"V minimum", "4.1945", "003 Ex. 6", kCorrect},
-        {"alpha at minimum", "(0, 0.1986, 0.8014)", "003 Ex. 6", "correct: the optimum is on the boundary"}}},
+       {{"integral", "3.5962", "[SS23] eq. 25", "correct up to double rounding (002 prints 3.59615)"},
+        {"V, equal budget", "4.9175", "[SS23] Ex. 6", kTruncated},
+        {"V minimum", "4.1945", "[SS23] Ex. 6", kCorrect},
+        {"alpha at minimum", "(0, 0.1986, 0.8014)", "[SS23] Ex. 6", "correct: the optimum is on the boundary"}}},
   };
   return table;
 }

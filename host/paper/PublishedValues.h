@@ -18,7 +18,7 @@ struct PublishedValue {
 // The rows of one example in print order. Throws std::invalid_argument for an unknown id.
 const std::vector<PublishedValue>& publishedValues(const std::string& exampleId);
 
-// verified_values.json, 003 "linear heuristic MC study (200 runs x 100 samples/technique)":
+// verified_values.json, [SS23] "linear heuristic MC study (200 runs x 100 samples/technique)":
 // quantiles of the exact variance at the heuristic's α, from an independent implementation.
 // Not in the paper; an expectation for ours.
 struct VarianceQuantiles {

@@ -9,7 +9,7 @@ namespace misalloc {
 namespace {
 
 // Probes: a uniform grid plus points 2^-j (b − a) from either end, so that the sign
-// of a mixture is seen in the thin boundary layers where 000 App. C's mixtures first
+// of a mixture is seen in the thin boundary layers where [HS14] App. C's mixtures first
 // turn negative.
 constexpr int kGridCells = 1024;
 constexpr int kBoundaryLevels = 40;

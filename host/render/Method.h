@@ -13,7 +13,7 @@ namespace misalloc {
 // probe finds best (render/Render.h).
 enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle };
 
-// Every method, in the order of the tables (000 Table 5.2's rows, then ours).
+// Every method, in the order of the tables ([HS14] Table 5.2's rows, then ours).
 const std::vector<Method>& allMethods();
 
 // Throws InputError for an unknown name.
@@ -22,7 +22,7 @@ std::string methodName(Method method);
 bool isAdaptive(Method method);
 
 // The estimator each method's stages use: σ/√c allocates for the estimator with
-// count-independent weights (002 Sec. 4); everything else for the balance heuristic.
+// count-independent weights ([SHS16] Sec. 4); everything else for the balance heuristic.
 Estimator methodEstimator(Method method);
 
 // The running sums (kernels/stats.h) and whether the stored samples are needed.

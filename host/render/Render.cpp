@@ -25,18 +25,18 @@ Allocation allocatePixel(Method method, const AdaptiveOptions& options, const Pi
                          const PixelSamples* samples) {
   switch (method) {
     case Method::Heuristic:
-      return allocateHeuristic(stats, options.costs);  // 000 eq. 4.20
+      return allocateHeuristic(stats, options.costs);  // [HS14] eq. 4.20
     case Method::SigmaSqrtC:
-      return allocateSigmaSqrtC(stats, options.costs);  // 002 eq. 31
+      return allocateSigmaSqrtC(stats, options.costs);  // [SHS16] eq. 31
     case Method::Linear:
-      return allocateLinear(*samples, options.linearRule);  // 003 eq. 14
+      return allocateLinear(*samples, options.linearRule);  // [SS23] eq. 14
     default:
       throw std::logic_error("no per-pixel rule for " + methodName(method));
   }
 }
 
 // Every technique takes at least one sample of each stage. The count-independent
-// estimator (002 eq. 26) needs one of each technique for all its terms, and with the
+// estimator ([SHS16] eq. 26) needs one of each technique for all its terms, and with the
 // BRDF split into lobes the specular lobe alone does not cover the diffuse lobe's
 // support. With the balance heuristic and M = 2 either technique alone is unbiased, but
 // a pilot that misses a sun (rooitou_park: 0.1 % of the texels) can drive α_envmap to

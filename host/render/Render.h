@@ -10,7 +10,7 @@
 
 namespace misalloc {
 
-// The batched schedule of the adaptive methods (000 Algorithm 1, Sec. 5.2).
+// The batched schedule of the adaptive methods ([HS14] Algorithm 1, Sec. 5.2).
 struct AdaptiveOptions {
   double pilotFraction = 0.05;  // of N, split equally among the techniques
   int stages = 1;               // after the pilot
@@ -50,9 +50,9 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);
 
 // Estimated variance of a pixel's stage estimate from the per-technique moments of
-// its luminance values w. Balance heuristic, multi-sample: Σ_k n_k s_k² / N² (002 eq. 21
-// with estimated σ_k); one-sample: s² / N over all samples (002 Table 2);
-// count-independent weights: Σ_k s_k² / n_k (002 eq. 28).
+// its luminance values w. Balance heuristic, multi-sample: Σ_k n_k s_k² / N² ([SHS16] eq. 21
+// with estimated σ_k); one-sample: s² / N over all samples ([SHS16] Table 2);
+// count-independent weights: Σ_k s_k² / n_k ([SHS16] eq. 28).
 double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator);
 
 }  // namespace misalloc

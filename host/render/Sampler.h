@@ -24,7 +24,7 @@ class StageSampler {
   // samples in the layout of kernels/stats.h's storedSampleIndex.
   virtual std::vector<double> statistics() = 0;
   virtual std::vector<float> storedSamples() = 0;
-  // 000 Algorithm 1 over every sample taken so far, with the grid of config().gridSize:
+  // [HS14] Algorithm 1 over every sample taken so far, with the grid of config().gridSize:
   // the searches keep running sums, and each adds the samples of the stages since the
   // one before (kernels/gridsearch.cl on a device, its C++ reference on the host).
   // `pooling`: select by rule (b) over neighbourhoods, with the skip rule.

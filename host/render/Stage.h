@@ -5,9 +5,9 @@
 namespace misalloc {
 
 enum class Estimator {
-  MultiSample,       // balance heuristic with deterministic counts (000 eq. 4.1)
+  MultiSample,       // balance heuristic with deterministic counts ([HS14] eq. 4.1)
   OneSample,         // balance heuristic, technique drawn with probabilities α
-  CountIndependent,  // weights p_k/Σ_l p_l whatever the counts (002 eq. 26)
+  CountIndependent,  // weights p_k/Σ_l p_l whatever the counts ([SHS16] eq. 26)
 };
 
 // What one sampling stage takes per pixel: counts n_k (multi-sample; for the
@@ -40,7 +40,7 @@ struct SamplerConfig {
   // > 0: every sample taken since the last grid search (all of them, without searches)
   // is stored, up to this many per pixel.
   int sampleCapacity = 0;
-  int gridSize = 0;  // > 0: grid searches (000 Algorithm 1) over about this many combinations
+  int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
 };
 
 }  // namespace misalloc
