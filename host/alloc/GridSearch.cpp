@@ -235,6 +235,8 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   float stageMix[M];
   kern::stageMixture(M, added, stageMix);
   float* sumS2 = sums + kern::runningSumIndex(0, 0, 1, 0, M, padded);
+  float* sumM[M];
+  for (int j = 0; j < M; ++j) sumM[j] = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
   const float* x = prepared;
   for (int i = 0; i < kern::preparedFirst(added, M); ++i, x += M + 1) {
     float r[M];
@@ -247,10 +249,7 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
         for (int v = 0; v < kGridVectors; ++v) {
           int l = l0 + 16 * v + lane;
           sumS2[l] = std::fma(g[v], w, sumS2[l]);
-          for (int j = 0; j < M; ++j) {
-            float* m = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
-            m[l] = std::fma(g[v], r[j], m[l]);
-          }
+          for (int j = 0; j < M; ++j) sumM[j][l] = std::fma(g[v], r[j], sumM[j][l]);
         }
       }
   }
