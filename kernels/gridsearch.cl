@@ -20,9 +20,23 @@
 
 #define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
 
+// g = f/p_α of the prepared sample x (prepareSample) for the combinations of the pass,
+// alpha[v][k] holding α_k of the 16 combinations of vector v: one division for all
+// (MA_BATCH_QUOTIENTS).
+MA_FN void passQuotients(__global const float* x, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES], float16* g) {
+  float16 p[MA_GRID_VECTORS];
+  MA_UNROLL
+  for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+    p[v] = alpha[v][0] * x[1];
+    MA_UNROLL
+    for (int k = 1; k < MA_TECHNIQUES; ++k) p[v] = fma(alpha[v][k], (float16)x[1 + k], p[v]);
+  }
+  MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x[0], p, g);
+}
+
 // Adds g and g² of technique j's n prepared samples (prepareSample) to its sums for the
 // combinations l0 … l0 + MA_PASS − 1 ([HS14] Alg. 1 line 8; eq. 6.6 and 6.8 before dividing
-// by m_j). alpha[v][k] holds α_k of the 16 combinations of vector v.
+// by m_j).
 MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
                         float16* sumG, float16* sumG2) {
   float16 s[MA_GRID_VECTORS], s2[MA_GRID_VECTORS];
@@ -33,14 +47,8 @@ MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alp
   }
   for (int i = 0; i < n; ++i) {
     __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
-    float16 p[MA_GRID_VECTORS], g[MA_GRID_VECTORS];
-    MA_UNROLL
-    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
-      p[v] = alpha[v][0] * x[1];
-      MA_UNROLL
-      for (int k = 1; k < MA_TECHNIQUES; ++k) p[v] = fma(alpha[v][k], (float16)x[1 + k], p[v]);
-    }
-    MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x[0], p, g);
+    float16 g[MA_GRID_VECTORS];
+    passQuotients(x, alpha, g);
     MA_UNROLL
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       s[v] += g[v];
@@ -63,14 +71,8 @@ MA_FN void sumMixture(__global const float* prepared, int n, const float16 alpha
     __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
     float r[MA_TECHNIQUES];
     float w = mixtureWeights(MA_TECHNIQUES, stageMix, x, r);
-    float16 p[MA_GRID_VECTORS], g[MA_GRID_VECTORS];
-    MA_UNROLL
-    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
-      p[v] = alpha[v][0] * x[1];
-      MA_UNROLL
-      for (int k = 1; k < MA_TECHNIQUES; ++k) p[v] = fma(alpha[v][k], (float16)x[1 + k], p[v]);
-    }
-    MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x[0], p, g);
+    float16 g[MA_GRID_VECTORS];
+    passQuotients(x, alpha, g);
     MA_UNROLL
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       sumS2[v] = fma(g[v], (float16)w, sumS2[v]);
