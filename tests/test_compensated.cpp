@@ -14,6 +14,7 @@
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "TestSize.h"
 #include "compare/EnvmapPdfComparison.h"
 #include "render/BrdfCoverage.h"
 #include "render/Reference.h"
@@ -184,6 +185,12 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
     for (bool split : {false, true})
       for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+        // The small size (tests/TestSize.h) keeps the first case, unsplit, with the
+        // alias sampler, under the seeds it has in the full sweep.
+        if (smallTestSize() && (&c != &cases[0] || split || s != EnvmapSampler::Alias)) {
+          seed += methods.size();
+          continue;
+        }
         Scene scene = compensatedScene(fmt::format("cosk:{}", c.K),
                                        fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), c.pdf, s, split);
         REQUIRE(scene.tables.pdf.compensated());
