@@ -9,16 +9,21 @@
 
 namespace misalloc {
 
-// Why an allocation departed from its formula. Bits, so one pixel can report several.
+namespace kern {
+#include "fallbacks.h"
+}  // namespace kern
+
+// Why an allocation departed from its formula. Bits, so one pixel can report several;
+// their meanings are in kernels/fallbacks.h, shared with the grid-search kernel.
 enum AllocationFallback : unsigned {
   kFallbackNone = 0,
-  kFallbackNonFinite = 1u << 0,         // NaN or ∞ in the sums: equal weights
-  kFallbackTooFewSamples = 1u << 1,     // a technique has fewer samples than the estimate needs: equal weights
-  kFallbackNoSignal = 1u << 2,          // every sample of the pixel has f = 0: equal weights
-  kFallbackSilentTechnique = 1u << 3,   // a technique saw only f = 0: its weight is 0
-  kFallbackZeroVariance = 1u << 4,      // a variance estimate is 0: the formula's limit is used
-  kFallbackInfiniteVariance = 1u << 5,  // every technique's variance is infinite: equal weights
-  kFallbackSingularSystem = 1u << 6,    // [SS23] eq. 14 has no unique solution: equal weights over the active set
+  kFallbackNonFinite = MA_FALLBACK_NON_FINITE,
+  kFallbackTooFewSamples = MA_FALLBACK_TOO_FEW_SAMPLES,
+  kFallbackNoSignal = MA_FALLBACK_NO_SIGNAL,
+  kFallbackSilentTechnique = MA_FALLBACK_SILENT_TECHNIQUE,
+  kFallbackZeroVariance = MA_FALLBACK_ZERO_VARIANCE,
+  kFallbackInfiniteVariance = MA_FALLBACK_INFINITE_VARIANCE,
+  kFallbackSingularSystem = MA_FALLBACK_SINGULAR_SYSTEM,
 };
 
 struct Allocation {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "Constants.h"
 #include "KernelCode.h"
 namespace misalloc::kern {
 #include "gridsearch.h"
@@ -14,11 +15,6 @@ namespace misalloc::kern {
 
 namespace misalloc {
 
-static_assert(MA_FALLBACK_NON_FINITE == kFallbackNonFinite && MA_FALLBACK_TOO_FEW_SAMPLES == kFallbackTooFewSamples &&
-                  MA_FALLBACK_NO_SIGNAL == kFallbackNoSignal &&
-                  MA_FALLBACK_SILENT_TECHNIQUE == kFallbackSilentTechnique &&
-                  MA_FALLBACK_SINGULAR_SYSTEM == kFallbackSingularSystem,
-              "kernels/gridsearch.h must use the bits of AllocationFallback");
 static_assert(MA_GRID_MAX_TECHNIQUES == kMaxTechniques);
 
 namespace {
@@ -402,7 +398,7 @@ WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::ve
 }
 
 std::size_t StoredSampleLayout::floatCount() const {
-  return (std::size_t(pixelCount) + 15) / 16 * 16 * std::size_t(capacity) * std::size_t(techniqueCount + 2);
+  return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
 
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize) {
@@ -466,7 +462,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(lanes.cost), cost = upload(toFloats(costs));
   // The prepared samples' buffer is kept from run to run: a new one costs the kernel
   // a page fault per 4 KiB, and page faults do not scale across threads.
-  std::size_t preparedFloats = std::max<std::size_t>(1, (std::size_t(pixels) + 15) / 16 * 16 * layout.taken * (m + 1));
+  std::size_t preparedFloats = std::max<std::size_t>(1, paddedPixelCount(std::size_t(pixels)) * layout.taken * (m + 1));
   if (preparedFloats > preparedFloats_) {
     prepared_ = cl::Buffer(device_.context, CL_MEM_READ_WRITE, preparedFloats * sizeof(float));
     preparedFloats_ = preparedFloats;
@@ -494,7 +490,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   kernel_.setArg(a++, scores_);
   kernel_.setArg(a++, scales_);
   cl::Event done;
-  const int blocks = (pixels + 15) / 16;
+  const int blocks = int(paddedPixelCount(std::size_t(pixels)) / kPixelBlock);
   device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange,
                                      cl::NDRange((blocks + kLocalSize - 1) / kLocalSize * kLocalSize),
                                      cl::NDRange(kLocalSize), nullptr, &done);

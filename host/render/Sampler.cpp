@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "Constants.h"
 #include "Error.h"
 #include "KernelCode.h"
 
@@ -38,7 +39,7 @@ int StageSampler::statSlots() const {
 }
 
 size_t StageSampler::storedSampleCount() const {
-  size_t paddedPixels = (size_t(scene_.pixelCount()) + 15) / 16 * 16;
+  size_t paddedPixels = paddedPixelCount(size_t(scene_.pixelCount()));
   return paddedPixels * size_t(config_.sampleCapacity) * size_t(scene_.techniqueCount() + 2);
 }
 
@@ -79,7 +80,7 @@ void StageSampler::reset() {
 
 std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
   const int M = scene.techniqueCount();
-  std::vector<float> samples((size_t(scene.pixelCount()) + 15) / 16 * 16 * size_t(capacity) * size_t(M + 2), 1.0f);
+  std::vector<float> samples(paddedPixelCount(size_t(scene.pixelCount())) * size_t(capacity) * size_t(M + 2), 1.0f);
   for (size_t record = 0; record < samples.size() / 16; ++record) {
     int q = int(record % size_t(M + 2));
     if (q < 2) std::fill_n(samples.begin() + record * 16, 16, 0.0f);
