@@ -16,12 +16,14 @@
 #include <thread>
 
 #include "CliRunner.h"
+#include "RunRecords.h"
 #include "compare/ErrorCurve.h"
 #include "compare/ErrorTimePlot.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
 
 using namespace misalloc;
+using misalloc::test::record;
 using misalloc::test::runMisalloc;
 using misalloc::test::TempDir;
 namespace fs = std::filesystem;
@@ -33,18 +35,6 @@ ErrorCurve monteCarloCurve(double a, std::vector<double> times) {
   std::vector<CurvePoint> points;
   for (double t : times) points.push_back({t, a / t});
   return ErrorCurve(points);
-}
-
-RunRecord record(const std::string& label, Method m, int budget, int repeat, double seconds, double mse) {
-  RunRecord r;
-  r.caseLabel = label;
-  r.method = m;
-  r.budget = budget;
-  r.repeat = repeat;
-  r.wallSeconds = r.kernelSeconds = seconds;
-  r.mse = mse;
-  r.meanAlpha = {0.5, 0.5};
-  return r;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
+#include "RunRecords.h"
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -209,17 +210,6 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
 
 TEST_CASE("compare runs each scene with each envmap pdf and compares them with equal and plain",
           "[compensated][compare]") {
-  auto runRecord = [](const std::string& label, Method m, int budget, int repeat, double seconds, double mse) {
-    RunRecord r;
-    r.caseLabel = label;
-    r.method = m;
-    r.budget = budget;
-    r.repeat = repeat;
-    r.wallSeconds = r.kernelSeconds = seconds;
-    r.mse = mse;
-    r.meanAlpha = {0.5, 0.5};
-    return r;
-  };
   // Two pdfs of one scene: the compensated one halves equal's MSE at the same times, so
   // under the Monte Carlo law MSE ∝ 1/t plain equal needs twice as long.
   Comparison c;
@@ -228,7 +218,7 @@ TEST_CASE("compare runs each scene with each envmap pdf and compares them with e
     const std::string label = std::string("m-") + pdf;
     c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
     for (int budget : {10, 20})
-      c.runs.push_back(runRecord(label, Method::Equal, budget, 0, 0.01 * budget,
+      c.runs.push_back(record(label, Method::Equal, budget, 0, 0.01 * budget,
                                  (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));
   }
   CompareOptions o;

@@ -15,7 +15,7 @@ struct AdaptiveOptions {
   double pilotFraction = 0.05;  // of N, split equally among the techniques
   int stages = 1;               // after the pilot
   int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
-  double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/PooledSelection.h)
+  double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
   std::vector<double> costs;   // c_k per sample, one per technique
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
