@@ -208,7 +208,7 @@ std::vector<NamedFile> envmapInputs(const std::vector<SceneOptions>& scenes) {
 // search's sums, refused up front with the option that asks for it: `sppOption` is
 // --spp for render, --budgets for compare.
 void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::string& sppOption, int spp,
-                             const AdaptiveOptions& adaptive, const std::string& deviceSpec) {
+                             const AdaptiveOptions& adaptive, bool onHost) {
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
   const double pixels = double(scene.width) * scene.height, M = scene.splitBrdf ? 3 : 2;
   if (config.sampleCapacity > 0) {
@@ -227,7 +227,7 @@ void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::str
     // (alloc/GridSearch.h). Both from the options alone: building the grid to size it
     // would be the allocation this check prevents.
     const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
-    const double sumBytes = deviceSpec == "host" ? pixels * 2 * M * U * sizeof(float) : 0;
+    const double sumBytes = onHost ? pixels * 2 * M * U * sizeof(float) : 0;
     requireHostMemory(fmt::format("--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U,
                                   (M + 1) * sizeof(float),
                                   sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels,
@@ -274,7 +274,7 @@ int main(int argc, char** argv) {
   renderCmd->add_option("--estimator", estimatorName, "fixed splits: multi ([HS14] eq. 4.1) or one (one-sample MIS)")
       ->capture_default_str();
   renderCmd->add_option("--seed", seed, "random seed")->capture_default_str()->check(anyUnsigned64());
-  renderCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, an index from `misalloc devices`, or host (C++)")
+  renderCmd->add_option("--device", deviceSpec, "comma-separated: auto, cpu, gpu, an index from `misalloc devices`, host (C++), all, or D:N (device D in N sub-devices)")
       ->capture_default_str();
   renderCmd->add_option("--out", out, "output EXR")->capture_default_str();
   renderCmd->add_option("--report", reportPath, "output JSON report")->capture_default_str();
@@ -295,7 +295,7 @@ int main(int argc, char** argv) {
   referenceScene.add(referenceCmd);
   std::string referenceOut;
   referenceCmd->add_option("--spp", referenceSpp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
-  referenceCmd->add_option("--device", deviceSpec, "auto, cpu, gpu, index or host")->capture_default_str();
+  referenceCmd->add_option("--device", deviceSpec, "comma-separated: auto, cpu, gpu, index, host, all or D:N")->capture_default_str();
   referenceCmd->add_option("--cache-dir", cacheDir, "where references are cached")->capture_default_str();
   referenceCmd->add_option("--out", referenceOut, "also write the reference to this EXR");
 
@@ -323,7 +323,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(integerIn(1, INT_MAX));
   compareCmd->add_option("--out-dir", compare.outDir, "output folder (created if missing)")->required();
-  compareCmd->add_option("--device", compare.device, "auto, cpu, gpu, an index, or host (C++)")->capture_default_str();
+  compareCmd->add_option("--device", compare.device, "comma-separated: auto, cpu, gpu, an index, host (C++), all or D:N")->capture_default_str();
   compareCmd->add_option("--local-size", compare.localSize, "OpenCL work-group size")
       ->capture_default_str()
       ->check(integerIn(1, INT_MAX));
@@ -374,16 +374,16 @@ int main(int argc, char** argv) {
       if (m == Method::Oracle && adaptive.oracleSamples < 2 * scene.techniqueCount())
         throw InputError(
             fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
-      std::unique_ptr<Device> device;
+      SamplerDevices devices(deviceSpec);
       SamplerConfig config = samplerConfigFor(m, estimator, spp, adaptive);
-      requireStatisticsMemory(scene.options, m, "--spp", spp, adaptive, deviceSpec);
-      auto sampler = makeStageSampler(deviceSpec, device, scene, config, localSize);
-      std::string deviceName = samplerDeviceName(device);
+      requireStatisticsMemory(scene.options, m, "--spp", spp, adaptive, devices.includesHost());
+      auto sampler = devices.makeSampler(scene, config, localSize);
+      std::string deviceName = devices.name();
       // Without statistics: for the reference and for measuring costs.
       std::unique_ptr<StageSampler> plain;
       const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
       auto plainSampler = [&]() -> StageSampler& {
-        if (!plain) plain = makeStageSampler(deviceSpec, device, plainScene, SamplerConfig{}, localSize);
+        if (!plain) plain = devices.makeSampler(plainScene, SamplerConfig{}, localSize);
         return *plain;
       };
       std::optional<Reference> reference;
@@ -439,7 +439,8 @@ int main(int argc, char** argv) {
       for (const CompareCase& c : compare.cases)
         for (Method m : compare.methods)
           for (int budget : compare.budgets)
-            requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, compare.device);
+            requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive,
+                                    SamplerDevices(compare.device).includesHost());
       requireBrdfCoverage(compare);
       std::vector<SceneOptions> scenes;
       for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
@@ -464,8 +465,7 @@ int main(int argc, char** argv) {
       OutputSet outputs(envmapInputs({referenceScene.parsed()}));
       if (!referenceOut.empty()) outputs.claim("--out", referenceOut);
       Scene scene = referenceScene.make();
-      std::unique_ptr<Device> device;
-      auto sampler = makeStageSampler(deviceSpec, device, scene, SamplerConfig{}, localSize);
+      auto sampler = SamplerDevices(deviceSpec).makeSampler(scene, SamplerConfig{}, localSize);
       auto reference = findReference(*sampler, scene, referenceSpp, cacheDir, true);
       if (!referenceOut.empty()) outputs.put(referenceOut, encodeExr(reference->image));
       outputs.commit();

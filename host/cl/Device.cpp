@@ -25,10 +25,25 @@ std::vector<cl::Platform> platforms() {
 
 bool hasType(const cl::Device& d, cl_device_type type) { return (d.getInfo<CL_DEVICE_TYPE>() & type) != 0; }
 
+Device withQueue(const cl::Platform& platform, const cl::Device& device) {
+  Device dev{platform, device, {}, {}, {}};
+  dev.context = cl::Context(dev.device);
+  dev.queue = cl::CommandQueue(dev.context, dev.device, CL_QUEUE_PROFILING_ENABLE);
+  return dev;
+}
+
+// The most sub-devices of equal compute units that `d` can be split into; 0 if none.
+cl_uint maxEqualSubDevices(const cl::Device& d) {
+  std::vector<cl_device_partition_property> kinds = d.getInfo<CL_DEVICE_PARTITION_PROPERTIES>();
+  if (std::find(kinds.begin(), kinds.end(), CL_DEVICE_PARTITION_EQUALLY) == kinds.end()) return 0;
+  return std::min(d.getInfo<CL_DEVICE_PARTITION_MAX_SUB_DEVICES>(), d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+}
+
 }  // namespace
 
 std::string Device::name() const {
-  return fmt::format("{} ({})", device.getInfo<CL_DEVICE_NAME>(), platform.getInfo<CL_PLATFORM_NAME>());
+  return fmt::format("{} ({}){}", device.getInfo<CL_DEVICE_NAME>(), platform.getInfo<CL_PLATFORM_NAME>(),
+                     part.empty() ? "" : ", " + part);
 }
 
 std::vector<std::pair<cl::Platform, cl::Device>> enumerateDevices() {
@@ -46,10 +61,14 @@ void listDevices(std::ostream& out) {
   if (all.empty()) throw DeviceError(kInstallAdvice);
   for (size_t i = 0; i < all.size(); ++i) {
     const auto& [p, d] = all[i];
-    out << fmt::format("[{}] {} | {} | {} | {} compute units | {} MiB | {}\n", i, p.getInfo<CL_PLATFORM_NAME>(),
-                       d.getInfo<CL_DEVICE_NAME>(), hasType(d, CL_DEVICE_TYPE_GPU) ? "gpu" : "cpu",
-                       d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>() >> 20,
-                       d.getInfo<CL_DEVICE_VERSION>());
+    const cl_uint subDevices = maxEqualSubDevices(d);
+    const std::string type = hasType(d, CL_DEVICE_TYPE_GPU) ? "gpu" : "cpu";
+    out << fmt::format("[{}] {} | {} | {} | {} compute units | {} MiB | {}{}\n", i, p.getInfo<CL_PLATFORM_NAME>(),
+                       d.getInfo<CL_DEVICE_NAME>(), type, d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(),
+                       d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>() >> 20, d.getInfo<CL_DEVICE_VERSION>(),
+                       subDevices > 1 ? fmt::format(" | sub-devices: --device {}{}:N, N = 2..{}",
+                                                    type == "cpu" ? "cpu:N or --device " : "", i, subDevices)
+                                      : "");
   }
 }
 
@@ -80,10 +99,34 @@ Device openDevice(const std::string& spec) {
                                    spec, all.size() - 1));
     it = all.begin() + index;
   }
-  Device dev{it->first, it->second, {}, {}};
-  dev.context = cl::Context(dev.device);
-  dev.queue = cl::CommandQueue(dev.context, dev.device, CL_QUEUE_PROFILING_ENABLE);
-  return dev;
+  return withQueue(it->first, it->second);
+}
+
+std::vector<Device> openAllDevices() {
+  auto all = enumerateDevices();
+  if (all.empty()) throw DeviceError(kInstallAdvice);
+  std::vector<Device> devices;
+  for (const auto& [platform, device] : all) devices.push_back(withQueue(platform, device));
+  return devices;
+}
+
+std::vector<Device> openSubDevices(const std::string& spec, int count) {
+  Device whole = openDevice(spec);
+  const cl_uint most = maxEqualSubDevices(whole.device);
+  if (count < 1 || cl_uint(count) > std::max<cl_uint>(most, 1) || (count > 1 && most < 2))
+    throw InputError(fmt::format("--device {}:{}: {} splits into at most {} sub-devices of equal compute units", spec,
+                                 count, whole.name(), std::max<cl_uint>(most, 1)));
+  if (count == 1) return {std::move(whole)};
+  const cl_uint units = whole.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>() / cl_uint(count);
+  const cl_device_partition_property equally[] = {CL_DEVICE_PARTITION_EQUALLY, cl_device_partition_property(units), 0};
+  std::vector<cl::Device> parts;
+  whole.device.createSubDevices(equally, &parts);
+  std::vector<Device> devices;
+  for (int i = 0; i < count; ++i) {
+    devices.push_back(withQueue(whole.platform, parts.at(size_t(i))));
+    devices.back().part = fmt::format("sub-device {}/{}", i + 1, count);
+  }
+  return devices;
 }
 
 cl::Program buildProgram(const Device& device, const std::string& mainFile, const std::string& options) {

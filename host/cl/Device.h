@@ -12,6 +12,7 @@ struct Device {
   cl::Device device;
   cl::Context context;
   cl::CommandQueue queue;
+  std::string part;  // a sub-device's place in its device, e.g. "sub-device 1/2"; else empty
 
   std::string name() const;
 };
@@ -25,6 +26,14 @@ void listDevices(std::ostream& out);
 // into enumerateDevices(). Throws DeviceError with install advice if there is no
 // OpenCL platform, InputError for a spec that matches nothing.
 Device openDevice(const std::string& spec);
+
+// Every OpenCL device (`--device all`).
+std::vector<Device> openAllDevices();
+
+// The device `spec` names (as openDevice) partitioned into `count` sub-devices of equal
+// compute units (clCreateSubDevices, CL_DEVICE_PARTITION_EQUALLY), each with its own
+// context and queue (`--device cpu:N`). Throws InputError where the device cannot.
+std::vector<Device> openSubDevices(const std::string& spec, int count);
 
 // The device time between a command's start and end (profiling events).
 double eventSeconds(const cl::Event& event);

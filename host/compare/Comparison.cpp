@@ -146,14 +146,14 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
   fs::create_directories(options.outDir);
   const int perCase = int(options.methods.size() * options.budgets.size()) * options.repeats;
   ProgressMeter meter(int(options.cases.size()) * perCase);
-  std::unique_ptr<Device> device;
+  SamplerDevices devices(options.device);
   Comparison out;
   for (const CompareCase& c : options.cases) {
     Scene scene = makeScene(c.scene);
     fs::create_directories(fs::path(options.outDir) / c.label);
     // The reference and the costs with the plain envmap pdf ([Kar19]: withPlainEnvmapPdf).
     const Scene plainScene = withPlainEnvmapPdf(scene);
-    auto plain = makeStageSampler(options.device, device, plainScene, SamplerConfig{}, options.localSize);
+    auto plain = devices.makeSampler(plainScene, SamplerConfig{}, options.localSize);
     meter.note(
         fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
     std::optional<Reference> reference =
@@ -162,16 +162,15 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     bool measured = adaptive.costs.empty();
     if (measured) adaptive.costs = measureCosts(*plain);
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs,
-                         measured ? "measured" : "--cost", reference->source, samplerDeviceName(device)});
+                         measured ? "measured" : "--cost", reference->source, devices.name()});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
     for (Method method : options.methods)
       for (int budget : options.budgets) {
         // Built (and its kernels compiled) once; each render starts it afresh.
-        auto sampler =
-            makeStageSampler(options.device, device, scene,
-                             samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize);
+        auto sampler = devices.makeSampler(scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive),
+                                           options.localSize);
         for (int r = 0; r < options.repeats; ++r) {
           if (guard.requested()) {
             out.interrupted = true;

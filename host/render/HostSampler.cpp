@@ -24,19 +24,20 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
 
 HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
+  share_.name = kHostSamplerName;
   if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
   if (config.gridSize > 0)
     gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize);
 }
 
-void HostSampler::clearSums() {
+void HostSampler::forgetStages() {
   std::fill(stats_.begin(), stats_.end(), 0.0);
   if (gridSearch_) gridSearch_->reset();
+  share_ = DeviceShare{share_.name, "", 0, 0, 0, 0, ""};
 }
 
-StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
-  const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
-  const int firstSlot = takeSlots(plan);
+StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
+  const int M = scene_.techniqueCount();
   kern::EnvmapView env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
   kern::TechniqueSet ts;
   ts.techniqueCount = M;
@@ -46,11 +47,11 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
   const int slots = plan.keepStatistics ? statSlots() : 0;
   const int perTechnique = MA_STATS_PER_TECHNIQUE(int(config.statsMask), M);
   StageResult result;
-  result.rgb.assign(size_t(pixels) * 3, 0.0);
-  result.moments.assign(size_t(pixels) * M * 2, 0.0);
+  result.rgb.assign(size_t(range.size()) * 3, 0.0);
+  result.moments.assign(size_t(range.size()) * M * 2, 0.0);
   auto start = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(dynamic, 64)
-  for (int pixel = 0; pixel < pixels; ++pixel) {
+  for (int pixel = range.begin; pixel < range.end; ++pixel) {
     const PhongParameters& p = scene_.grid.pixels[pixel];
     kern::PhongParams b;
     b.rhoD = p.rhoD;
@@ -86,14 +87,19 @@ StageResult HostSampler::run(const StagePlan& plan, uint64_t seed) {
           samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, M)] = s.pdfs[l];
       }
     }
-    double* rgb = result.rgb.data() + size_t(pixel) * 3;
+    const size_t row = size_t(pixel - range.begin);
+    double* rgb = result.rgb.data() + row * 3;
     rgb[0] = sums.r;
     rgb[1] = sums.g;
     rgb[2] = sums.b;
     const double moments[6] = {sums.w0, sums.ww0, sums.w1, sums.ww1, sums.w2, sums.ww2};
-    std::copy(moments, moments + 2 * M, result.moments.data() + size_t(pixel) * M * 2);
+    std::copy(moments, moments + 2 * M, result.moments.data() + row * M * 2);
   }
   result.kernelSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  share_.pixelStages += range.size();
+  share_.samples += (long long)range.size() * plan.stageSamples;
+  share_.tiles += 1;
+  share_.kernelSeconds += result.kernelSeconds;
   return result;
 }
 

@@ -292,6 +292,8 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
                                 double(sampler.storedSampleCount()) * sizeof(float) / pixels +
                                 double(sampler.searchBytesPerPixel());
   out.kernelSeconds = progress.totals.kernelSeconds;
+  out.devices = sampler.deviceShares();
+  out.imbalanceSeconds = sampler.imbalanceSeconds();
   out.wallSeconds = secondsSince(start);
   out.hostSeconds = std::max(0.0, out.wallSeconds - out.kernelSeconds - out.allocationSeconds);
   return out;

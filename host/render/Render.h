@@ -40,6 +40,8 @@ struct Rendering {
   double allocationSeconds = 0;  // reading statistics back and allocating
   double hostSeconds = 0;        // everything else: planning, transfers, reductions
   double wallSeconds = 0;
+  std::vector<DeviceShare> devices;  // where it ran (render/TiledSampler.h for several)
+  double imbalanceSeconds = 0;       // several devices: Σ over stages of last finish − first finish
 };
 
 // Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods

@@ -35,6 +35,26 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
   return pdf;
 }
 
+// Each device's share of the pixels and samples; with several, how far apart they
+// finished (render/TiledSampler.h).
+nlohmann::json devicesJson(const Rendering& r) {
+  long long pixelStages = 0, samples = 0;
+  for (const DeviceShare& d : r.devices) pixelStages += d.pixelStages, samples += d.samples;
+  nlohmann::json list = nlohmann::json::array();
+  for (const DeviceShare& d : r.devices) {
+    nlohmann::json entry = {{"name", d.name},
+                            {"launch", d.launch},
+                            {"pixel_share", pixelStages > 0 ? double(d.pixelStages) / pixelStages : 0.0},
+                            {"sample_share", samples > 0 ? double(d.samples) / samples : 0.0},
+                            {"samples", d.samples},
+                            {"tiles", d.tiles},
+                            {"kernel_s", d.kernelSeconds}};
+    if (!d.failure.empty()) entry["failed"] = d.failure + "; its tiles ran again on the other devices";
+    list.push_back(entry);
+  }
+  return list;
+}
+
 }  // namespace
 
 nlohmann::json sceneJson(const Scene& scene) {
@@ -81,7 +101,12 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
       {"mean_alpha", meanAlpha},
       {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
+      {"devices", devicesJson(r)},
   };
+  if (r.devices.size() > 1) {
+    report["imbalance_s"] = r.imbalanceSeconds;
+    report["imbalance_fraction"] = r.imbalanceSeconds / r.wallSeconds;
+  }
   if (isAdaptive(run.method)) {
     nlohmann::json costs;
     for (int k = 0; k < M; ++k) costs[names[k]] = run.adaptive.costs[k];

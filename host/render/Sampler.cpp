@@ -19,10 +19,16 @@ cl::Buffer upload(const Device& d, const std::vector<T>& data, cl_mem_flags flag
 
 // Sums are double where the device has it (ma_acc in kernels/common.h), else float.
 template <typename Acc>
-std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t count) {
+std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t first, size_t count) {
   std::vector<Acc> raw(count);
-  d.queue.enqueueReadBuffer(buffer, CL_TRUE, 0, count * sizeof(Acc), raw.data());
+  d.queue.enqueueReadBuffer(buffer, CL_TRUE, first * sizeof(Acc), count * sizeof(Acc), raw.data());
   return std::vector<double>(raw.begin(), raw.end());
+}
+
+template <typename Acc>
+void writeSums(const Device& d, const cl::Buffer& buffer, const std::vector<double>& sums) {
+  std::vector<Acc> raw(sums.begin(), sums.end());
+  d.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, raw.size() * sizeof(Acc), raw.data());
 }
 
 }  // namespace
@@ -72,10 +78,18 @@ GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, G
   return result;
 }
 
+StageResult StageSampler::run(const StagePlan& plan, uint64_t seed) {
+  const int pixels = scene_.pixelCount();
+  if (plan.techniqueCount != scene_.techniqueCount() || plan.counts.size() != size_t(pixels) * plan.techniqueCount ||
+      plan.firstIndex.size() != plan.counts.size())
+    throw std::logic_error("stage plan does not match the scene");
+  return runPixels(plan, seed, takeSlots(plan), PixelRange{0, pixels});
+}
+
 void StageSampler::reset() {
   taken_ = searched_ = 0;
   closed_ = false;
-  clearSums();
+  forgetStages();
 }
 
 std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
@@ -135,6 +149,14 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   samples_ = config.sampleCapacity > 0
                  ? upload(device, emptyStoredSamples(scene, config.sampleCapacity), CL_MEM_READ_WRITE)
                  : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  const size_t pixels = size_t(scene.pixelCount()), M = size_t(scene.techniqueCount());
+  counts_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(int32_t));
+  firstIndex_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(uint32_t));
+  pixelOrder_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * sizeof(int32_t));
+  rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * 3 * accSize);
+  moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
+  share_.name = device.name();
+  share_.launch = fmt::format("local size {}", localSize);
   if (config.gridSize > 0)
     gridSearch_ = std::make_unique<GridSearch>(device, scene.techniqueCount(), scene.pixelCount(), config.gridSize);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
@@ -158,9 +180,9 @@ namespace {
 // share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort, ties
 // by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
 // work-group, so the order changes the time only, never the result.
-std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, int pixels) {
-  std::vector<int32_t> order(pixels);
-  std::iota(order.begin(), order.end(), 0);
+std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
+  std::vector<int32_t> order(range.size());
+  std::iota(order.begin(), order.end(), range.begin);
   const size_t M = size_t(plan.techniqueCount);
   // A comparison sort: its memory scales with the pixels, where a counting sort's
   // buckets 0..N took 4 bytes per sample of the stage.
@@ -174,16 +196,18 @@ std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, int pixels) {
 
 }  // namespace
 
-StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
-  const int pixels = scene_.pixelCount(), M = scene_.techniqueCount();
-  if (plan.techniqueCount != M || plan.counts.size() != size_t(pixels) * M)
-    throw std::logic_error("stage plan does not match the scene");
-  const int firstSlot = takeSlots(plan);
-  const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
-  cl::Buffer counts = upload(device_, plan.counts), firstIndex = upload(device_, plan.firstIndex);
-  cl::Buffer pixelOrder = upload(device_, coherentPixelOrder(plan, pixels));
-  cl::Buffer rgb(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * 3 * accSize);
-  cl::Buffer moments(device_.context, CL_MEM_WRITE_ONLY, size_t(pixels) * M * 2 * accSize);
+StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
+  const int M = scene_.techniqueCount();
+  StageResult result;
+  if (range.size() == 0) return result;
+  const size_t rows = size_t(range.size()) * M, firstRow = size_t(range.begin) * M;
+  const cl::CommandQueue& queue = device_.queue;
+  queue.enqueueWriteBuffer(counts_, CL_FALSE, firstRow * sizeof(int32_t), rows * sizeof(int32_t),
+                           plan.counts.data() + firstRow);
+  queue.enqueueWriteBuffer(firstIndex_, CL_FALSE, firstRow * sizeof(uint32_t), rows * sizeof(uint32_t),
+                           plan.firstIndex.data() + firstRow);
+  const std::vector<int32_t> order = coherentPixelOrder(plan, range);
+  queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
   int a = 0;
   kernel.setArg(a++, texels_);
@@ -193,44 +217,61 @@ StageResult Sampler::run(const StagePlan& plan, uint64_t seed) {
   kernel.setArg(a++, cl_int(scene_.tables.height));
   kernel.setArg(a++, brdfParams_);
   for (float m : scene_.mirror) kernel.setArg(a++, m);
-  kernel.setArg(a++, counts);
-  kernel.setArg(a++, firstIndex);
+  kernel.setArg(a++, counts_);
+  kernel.setArg(a++, firstIndex_);
   kernel.setArg(a++, cl_int(plan.stageSamples));
   kernel.setArg(a++, cl_uint(seed & 0xffffffffu));
   kernel.setArg(a++, cl_uint(seed >> 32));
-  kernel.setArg(a++, cl_int(pixels));
-  kernel.setArg(a++, pixelOrder);
-  kernel.setArg(a++, rgb);
-  kernel.setArg(a++, moments);
+  kernel.setArg(a++, cl_int(range.size()));
+  kernel.setArg(a++, pixelOrder_);
+  kernel.setArg(a++, rgb_);
+  kernel.setArg(a++, moments_);
   kernel.setArg(a++, stats_);
   kernel.setArg(a++, samples_);
   kernel.setArg(a++, cl_int(firstSlot));
   kernel.setArg(a++, cl_int(config_.sampleCapacity));
-  size_t global = (size_t(pixels) + localSize_ - 1) / localSize_ * localSize_;
+  size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
-  device_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr,
-                                     &done);
+  queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);
   done.wait();
-  StageResult result;
   result.kernelSeconds = eventSeconds(done);
-  auto read = [&](const cl::Buffer& b, size_t n) {
-    return doubleSums_ ? readSums<double>(device_, b, n) : readSums<float>(device_, b, n);
+  auto read = [&](const cl::Buffer& b, size_t first, size_t n) {
+    return doubleSums_ ? readSums<double>(device_, b, first, n) : readSums<float>(device_, b, first, n);
   };
-  result.rgb = read(rgb, size_t(pixels) * 3);
-  result.moments = read(moments, size_t(pixels) * M * 2);
+  result.rgb = read(rgb_, size_t(range.begin) * 3, size_t(range.size()) * 3);
+  result.moments = read(moments_, firstRow * 2, rows * 2);
+  share_.pixelStages += range.size();
+  share_.samples += (long long)range.size() * plan.stageSamples;
+  share_.tiles += 1;
+  share_.kernelSeconds += result.kernelSeconds;
   return result;
 }
 
 std::vector<double> Sampler::statistics() {
   const size_t n = size_t(scene_.pixelCount()) * statSlots();
   if (n == 0) return {};
-  return doubleSums_ ? readSums<double>(device_, stats_, n) : readSums<float>(device_, stats_, n);
+  return doubleSums_ ? readSums<double>(device_, stats_, 0, n) : readSums<float>(device_, stats_, 0, n);
 }
 
-void Sampler::clearSums() {
+void Sampler::loadStatistics(const std::vector<double>& stats) {
+  if (stats.size() != size_t(scene_.pixelCount()) * statSlots()) throw std::logic_error("statistics of another sampler");
+  if (stats.empty()) return;
+  doubleSums_ ? writeSums<double>(device_, stats_, stats) : writeSums<float>(device_, stats_, stats);
+}
+
+void Sampler::loadStoredSamples(const std::vector<float>& samples) {
+  if (samples.size() != storedSampleCount()) throw std::logic_error("stored samples of another sampler");
+  if (!samples.empty())
+    device_.queue.enqueueWriteBuffer(samples_, CL_TRUE, 0, samples.size() * sizeof(float), samples.data());
+}
+
+std::vector<DeviceShare> Sampler::deviceShares() const { return {share_}; }
+
+void Sampler::forgetStages() {
   const size_t bytes = size_t(scene_.pixelCount()) * statSlots() * (doubleSums_ ? sizeof(double) : sizeof(float));
   if (bytes > 0) device_.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, bytes);
   if (gridSearch_) gridSearch_->reset();
+  share_ = DeviceShare{share_.name, share_.launch, 0, 0, 0, 0, ""};
 }
 
 GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,

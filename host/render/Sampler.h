@@ -19,7 +19,8 @@ class StageSampler {
   StageSampler(const Scene& scene, const SamplerConfig& config);
   virtual ~StageSampler() = default;
 
-  virtual StageResult run(const StagePlan& plan, uint64_t seed) = 0;
+  // One stage for every pixel.
+  StageResult run(const StagePlan& plan, uint64_t seed);
   // The running sums, [pixel · slots + slot] (kernels/stats.h), and the stored
   // samples in the layout of kernels/stats.h's storedSampleIndex.
   virtual std::vector<double> statistics() = 0;
@@ -40,14 +41,29 @@ class StageSampler {
   size_t storedSampleCount() const;    // floats in the stored-samples buffer
   size_t searchBytesPerPixel() const;  // the grid searches' running sums
 
+  // Where the stages since reset() ran, for the report: every device's share (one
+  // entry for a single device), and how far apart their last tiles finished.
+  virtual std::vector<DeviceShare> deviceShares() const = 0;
+  virtual double imbalanceSeconds() const { return 0; }
+
  protected:
+  // TiledSampler drives its members' tiles and keeps their sums in step.
+  friend class TiledSampler;
+
+  // One stage for the pixels of `range` only: their estimates and moments, their running
+  // sums, their stored samples from slot `firstSlot` on.
+  virtual StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) = 0;
+  // Overwrite the running sums / stored samples with those of statistics() / storedSamples().
+  virtual void loadStatistics(const std::vector<double>& stats) = 0;
+  virtual void loadStoredSamples(const std::vector<float>& samples) = 0;
+
   // Records the stage and returns the stored-samples slot of its first sample. Slot i
   // holds sample searched_ + i: the samples before are in the grid searches' sums.
   // Throws std::logic_error if the stage does not fit.
   int takeSlots(const StagePlan& plan);
   virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
                                   const std::optional<PooledSelection>& pooling) = 0;
-  virtual void clearSums() = 0;
+  virtual void forgetStages() = 0;
 
   const Scene& scene_;
   SamplerConfig config_;
@@ -72,42 +88,54 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 class Sampler : public StageSampler {
  public:
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 8);
-  StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
+  std::vector<DeviceShare> deviceShares() const override;
 
- private:
+ protected:  // tests/test_devices.cpp injects failures into runPixels
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+  void loadStatistics(const std::vector<double>& stats) override;
+  void loadStoredSamples(const std::vector<float>& samples) override;
   GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
                           const std::optional<PooledSelection>& pooling) override;
-  void clearSums() override;
+  void forgetStages() override;
 
+ private:
   const Device& device_;
   std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
   int localSize_;
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
   cl::Buffer texels_, cdfTable_, aliasTable_, brdfParams_, stats_, samples_;
+  // A stage's per-pixel inputs and outputs, whole-image sized so that a tile writes its rows.
+  cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
+  DeviceShare share_;  // since reset()
 };
 
 // The C++ reference of Sampler: the same kernels/pixel.h functions, one pixel per
 // OpenMP iteration.
+inline constexpr const char* kHostSamplerName = "host (C++ reference, OpenMP)";
 class HostSampler : public StageSampler {
  public:
   HostSampler(const Scene& scene, const SamplerConfig& config = {});
-  StageResult run(const StagePlan& plan, uint64_t seed) override;
   std::vector<double> statistics() override { return stats_; }
   std::vector<float> storedSamples() override { return samples_; }
+  std::vector<DeviceShare> deviceShares() const override { return {share_}; }
 
  private:
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+  void loadStatistics(const std::vector<double>& stats) override { stats_ = stats; }
+  void loadStoredSamples(const std::vector<float>& samples) override { samples_ = samples; }
   GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
                           const std::optional<PooledSelection>& pooling) override {
     return gridSearch_->run(samples_, layout, costs, rule, pooling);
   }
-  void clearSums() override;
+  void forgetStages() override;
 
   std::vector<double> stats_;
   std::vector<float> samples_;
   std::unique_ptr<GridSearchReference> gridSearch_;  // where config().gridSize > 0
+  DeviceShare share_;  // since reset()
 };
 
 // Padding lanes of the stored samples: technique 0, f = 0 and every pdf 1, so that

@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "Error.h"
+#include "render/TiledSampler.h"
 
 namespace misalloc {
 namespace {
@@ -60,12 +61,38 @@ void requireTablesFit(const Device& device, const Scene& scene) {
         mebibytes(largest), device.name(), mebibytes(maxAlloc), mebibytes(global)));
 }
 
-}  // namespace
+// The entries of `--device LIST`; throws InputError for an empty entry.
+std::vector<std::string> deviceEntries(const std::string& list) {
+  std::vector<std::string> entries;
+  size_t begin = 0;
+  while (true) {
+    size_t comma = list.find(',', begin);
+    std::string entry = list.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    if (entry.empty()) throw InputError(fmt::format("--device '{}': an empty entry", list));
+    entries.push_back(entry);
+    if (comma == std::string::npos) return entries;
+    begin = comma + 1;
+  }
+}
 
-std::unique_ptr<StageSampler> makeStageSampler(const std::string& deviceSpec, std::unique_ptr<Device>& device,
-                                               const Scene& scene, const SamplerConfig& config, int localSize) {
-  if (deviceSpec == "host") return std::make_unique<HostSampler>(scene, config);
-  if (!device) device = std::make_unique<Device>(openDevice(deviceSpec));
+// "D:N" → (D, N); N must be a whole number of at least 1.
+std::pair<std::string, int> subDeviceEntry(const std::string& entry) {
+  const size_t colon = entry.rfind(':');
+  const std::string countText = entry.substr(colon + 1);
+  size_t used = 0;
+  int count = 0;
+  try {
+    count = std::stoi(countText, &used);
+  } catch (const std::exception&) {
+  }
+  if (used != countText.size() || count < 1)
+    throw InputError(fmt::format("--device {}: expected DEVICE:N with N ≥ 1 sub-devices", entry));
+  return {entry.substr(0, colon), count};
+}
+
+std::unique_ptr<StageSampler> makeDeviceSampler(const Device* device, const Scene& scene, const SamplerConfig& config,
+                                                int localSize) {
+  if (!device) return std::make_unique<HostSampler>(scene, config);
   requireTablesFit(*device, scene);
   try {
     // The constructor allocates every buffer and launches the kernel once.
@@ -75,8 +102,50 @@ std::unique_ptr<StageSampler> makeStageSampler(const std::string& deviceSpec, st
   }
 }
 
-std::string samplerDeviceName(const std::unique_ptr<Device>& device) {
-  return device ? device->name() : "host (C++ reference, OpenMP)";
+}  // namespace
+
+SamplerDevices::SamplerDevices(std::string list) : list_(std::move(list)) {}
+
+void SamplerDevices::open() {
+  if (opened_) return;
+  std::vector<std::unique_ptr<Device>> devices;
+  for (const std::string& entry : deviceEntries(list_)) {
+    std::vector<Device> opened;
+    if (entry == "host")
+      devices.push_back(nullptr);
+    else if (entry == "all")
+      opened = openAllDevices();
+    else if (entry.find(':') != std::string::npos) {
+      auto [spec, count] = subDeviceEntry(entry);
+      opened = openSubDevices(spec, count);
+    } else
+      opened.push_back(openDevice(entry));
+    for (Device& d : opened) devices.push_back(std::make_unique<Device>(std::move(d)));
+  }
+  devices_ = std::move(devices);
+  opened_ = true;
+}
+
+std::unique_ptr<StageSampler> SamplerDevices::makeSampler(const Scene& scene, const SamplerConfig& config,
+                                                          int localSize) {
+  open();
+  if (devices_.size() == 1) return makeDeviceSampler(devices_[0].get(), scene, config, localSize);
+  std::vector<std::unique_ptr<StageSampler>> members;
+  for (const auto& device : devices_) members.push_back(makeDeviceSampler(device.get(), scene, config, localSize));
+  return std::make_unique<TiledSampler>(scene, config, std::move(members));
+}
+
+std::string SamplerDevices::name() const {
+  std::string joined;
+  for (const auto& device : devices_)
+    joined += (joined.empty() ? "" : " + ") + (device ? device->name() : std::string(kHostSamplerName));
+  return joined.empty() ? list_ : joined;
+}
+
+bool SamplerDevices::includesHost() const {
+  for (const std::string& entry : deviceEntries(list_))
+    if (entry == "host") return true;
+  return false;
 }
 
 }  // namespace misalloc

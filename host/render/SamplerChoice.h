@@ -1,19 +1,33 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cl/Device.h"
 #include "render/Sampler.h"
 
 namespace misalloc {
 
-// The sampler that `--device` asks for: "host" is the C++ reference (HostSampler),
-// anything else an OpenCL device (openDevice), opened at the first call and kept in
-// `device` so that samplers built later share it.
-std::unique_ptr<StageSampler> makeStageSampler(const std::string& deviceSpec, std::unique_ptr<Device>& device,
-                                               const Scene& scene, const SamplerConfig& config, int localSize);
+// The devices `--device LIST` names: comma-separated entries, each auto, cpu, gpu, an
+// index of `misalloc devices`, host (the C++ reference, HostSampler), all (every OpenCL
+// device) or D:N (device D split into N sub-devices, openSubDevices). Opened at the
+// first sampler and kept, so that samplers built later share them.
+class SamplerDevices {
+ public:
+  explicit SamplerDevices(std::string list);
 
-// The name a report gives the sampler's device.
-std::string samplerDeviceName(const std::unique_ptr<Device>& device);
+  // One device: its sampler; several: a TiledSampler over one sampler each.
+  std::unique_ptr<StageSampler> makeSampler(const Scene& scene, const SamplerConfig& config, int localSize);
+  // What a report names: the devices, joined by " + ".
+  std::string name() const;
+  bool includesHost() const;
+
+ private:
+  void open();
+
+  std::string list_;
+  bool opened_ = false;
+  std::vector<std::unique_ptr<Device>> devices_;  // nullptr: the host
+};
 
 }  // namespace misalloc

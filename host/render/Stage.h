@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace misalloc {
@@ -25,12 +26,30 @@ struct StagePlan {
   bool keepStatistics = true;
 };
 
+// The pixels [begin, end) of the image, in index order: a tile of a stage.
+struct PixelRange {
+  int begin = 0, end = 0;
+  int size() const { return end - begin; }
+};
+
 // Per pixel: this stage's unbiased RGB estimate and, per technique, Σ w and Σ w² of
 // the luminance sample values w (kernels/pixel.h).
+// A tile's result holds its pixels only, pixel counted from the tile's first.
 struct StageResult {
   std::vector<double> rgb;      // [pixel·3 + c]
   std::vector<double> moments;  // [(pixel·M + k)·2 + {0, 1}]
   double kernelSeconds = 0;
+};
+
+// One device's part in the stages since a sampler's reset(), for the report.
+struct DeviceShare {
+  std::string name;
+  std::string launch;            // its local size and why (cl/LaunchShape.h); empty on the host
+  long long pixelStages = 0;     // pixels it ran, summed over the stages
+  long long samples = 0;         // samples it took
+  int tiles = 0;                 // kernel launches
+  double kernelSeconds = 0;      // its own device time
+  std::string failure;           // why it stopped, if it failed: its tiles ran elsewhere
 };
 
 // What a sampler keeps beyond the stage estimates, for the allocations.

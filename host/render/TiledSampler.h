@@ -1,0 +1,55 @@
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/Sampler.h"
+
+namespace misalloc {
+
+// One render split across several devices. Every stage is handed out in tiles of
+// pixels from one TileQueue, sized by each device's measured rate. A pixel's random
+// numbers are keyed on the pixel (kernels/rng.h) and its sums run in the same order
+// wherever it runs, so the image is the one a single device of the same arithmetic
+// makes, bit for bit. Each member keeps whole-image running sums and stored samples;
+// after a stage that keeps statistics, the rows each member ran are gathered here and
+// loaded into every member, so that any device can run any pixel in the next stage.
+// The grid searches run on the first member, which holds every stored sample then.
+//
+// A member that fails (an OpenCL error) is retired: its tile, and every tile it ran in
+// a stage whose running sums it alone holds, run again on the others, and its report
+// entry says why. With no member left, or when a grid search needs the first member and
+// it is lost (it holds the sums of the earlier searches), DeviceError.
+class TiledSampler : public StageSampler {
+ public:
+  // Members built for the same scene and config, one per device.
+  TiledSampler(const Scene& scene, const SamplerConfig& config, std::vector<std::unique_ptr<StageSampler>> members);
+
+  std::vector<double> statistics() override { return stats_; }
+  std::vector<float> storedSamples() override { return samples_; }
+  std::vector<DeviceShare> deviceShares() const override;
+  double imbalanceSeconds() const override { return imbalanceSeconds_; }
+
+ private:
+  // A stage's result: the wall time from the first launch to the last finish is its
+  // kernelSeconds, the time the cost-aware allocations pay for a sample.
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+  void loadStatistics(const std::vector<double>& stats) override;
+  void loadStoredSamples(const std::vector<float>& samples) override;
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                          const std::optional<PooledSelection>& pooling) override;
+  void forgetStages() override;
+
+  bool live(size_t member) const { return failures_[member].empty(); }
+  // Gathers the rows each member ran in the stage and loads them into every member.
+  void shareStatistics(const std::vector<std::vector<PixelRange>>& ran);
+
+  std::vector<std::unique_ptr<StageSampler>> members_;
+  std::vector<double> sampleRates_;     // samples per second of each member, 0 until measured
+  std::vector<std::string> failures_;   // per member: why it was retired, empty while it runs
+  std::vector<double> stats_;           // every pixel's running sums after the last stage
+  std::vector<float> samples_;          // and its stored samples
+  double imbalanceSeconds_ = 0;         // Σ over stages: last finish − first finish
+};
+
+}  // namespace misalloc

@@ -1,0 +1,173 @@
+// One render over several devices (render/TiledSampler.h): the same image, bit for bit,
+// as on one device of the same arithmetic, every pixel exactly once; a device that fails
+// has its tiles run again on the others, and with none left the render stops.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "CliRunner.h"
+#include "Error.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "render/Render.h"
+#include "render/SamplerChoice.h"
+#include "render/TiledSampler.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+AdaptiveOptions fixedCosts(const Scene& scene) {
+  AdaptiveOptions options;
+  options.costs.assign(scene.techniqueCount(), 1.0);  // measured costs differ between runs
+  options.stages = 2;                                 // a stage after the first allocation keeps statistics too
+  options.oracleSamples = 64;
+  return options;
+}
+
+Rendering renderOn(SamplerDevices& devices, const Scene& scene, Method method, Estimator estimator, int spp) {
+  AdaptiveOptions options = fixedCosts(scene);
+  auto sampler = devices.makeSampler(scene, samplerConfigFor(method, estimator, spp, options), 8);
+  return render(*sampler, method, options, spp, 11);
+}
+
+bool sameBits(const RgbImage& a, const RgbImage& b) {
+  return a.rgb.size() == b.rgb.size() && std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0;
+}
+
+// PoCL's CPU device in two sub-devices where it can be split, else twice the whole
+// device (two contexts): either way two devices of the same arithmetic.
+std::string twoCpuDevices() {
+  return testDevice().device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>() >= 2 ? "cpu:2" : "cpu,cpu";
+}
+
+// A Sampler whose `failAt`-th launch (counted from 1 since construction's warm-up)
+// fails as a lost device would.
+class FailingSampler : public Sampler {
+ public:
+  FailingSampler(const Device& device, const Scene& scene, const SamplerConfig& config, int failAt)
+      : Sampler(device, scene, config), failAt_(failAt), launches_(0) {}
+
+ protected:
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override {
+    if (++launches_ == failAt_) throw DeviceError("injected failure");
+    return Sampler::runPixels(plan, seed, firstSlot, range);
+  }
+
+ private:
+  int failAt_, launches_;
+};
+
+std::unique_ptr<TiledSampler> withFailingMember(const Scene& scene, const SamplerConfig& config,
+                                                const std::vector<int>& failAt) {
+  std::vector<std::unique_ptr<StageSampler>> members;
+  // The constructor's warm-up launches one or two stages (Sampler::Sampler).
+  const int warmUps = keepsStatistics(config) ? 2 : 1;
+  for (int f : failAt)
+    members.push_back(f > 0 ? std::make_unique<FailingSampler>(testDevice(), scene, config, warmUps + f)
+                            : std::make_unique<Sampler>(testDevice(), scene, config));
+  return std::make_unique<TiledSampler>(scene, config, std::move(members));
+}
+
+}  // namespace
+
+TEST_CASE("two devices render the image of one, bit for bit, with every method", "[devices]") {
+  // 40×26 pixels: not a whole number of 16-pixel blocks, so the last tile is partial.
+  const Scene two = smallScene("rooitou_park", "seed000", 40, 26);
+  const Scene three = smallScene("forest_slope", "seed000", 40, 26, true);
+  SamplerDevices one("cpu"), pair(twoCpuDevices());
+  for (const Scene* scene : {&two, &three}) {
+    for (Method method : allMethods()) {
+      std::vector<Estimator> estimators{Estimator::MultiSample};
+      if (!isAdaptive(method)) estimators = {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent};
+      for (Estimator estimator : estimators) {
+        Rendering a = renderOn(one, *scene, method, estimator, 40);
+        Rendering b = renderOn(pair, *scene, method, estimator, 40);
+        INFO(fmt::format("{} M={} estimator {}", methodName(method), scene->techniqueCount(), int(estimator)));
+        CHECK(sameBits(a.image, b.image));
+        CHECK(a.alpha == b.alpha);
+        REQUIRE(b.devices.size() == 2);
+        CHECK(b.devices[0].pixelStages + b.devices[1].pixelStages == a.devices[0].pixelStages);
+      }
+    }
+  }
+}
+
+TEST_CASE("the host device with PoCL gives the image within float rounding", "[devices]") {
+  // g++ and PoCL's compiler round some float operations differently (tests/test_sampler.cpp),
+  // so a mix with the host is equal to float precision, not bit for bit.
+  const Scene scene = smallScene("venice_sunset", "seed000", 40, 26);
+  SamplerDevices one("cpu"), mixed("cpu,host");
+  Rendering a = renderOn(one, scene, Method::Equal, Estimator::MultiSample, 32);
+  Rendering b = renderOn(mixed, scene, Method::Equal, Estimator::MultiSample, 32);
+  REQUIRE(a.image.rgb.size() == b.image.rgb.size());
+  size_t far = 0;
+  for (size_t i = 0; i < a.image.rgb.size(); ++i)
+    far += std::abs(a.image.rgb[i] - b.image.rgb[i]) > 1e-5 * std::abs(a.image.rgb[i]) + 1e-30;
+  CHECK(far == 0);
+  CHECK(b.devices.at(1).name == kHostSamplerName);
+  CHECK(b.devices.at(1).pixelStages > 0);
+}
+
+TEST_CASE("a failed device's tiles run again on the others: the same image", "[devices]") {
+  const Scene scene = smallScene("studio_small_03", "seed000", 40, 26);
+  for (Method method : {Method::Equal, Method::Heuristic, Method::Exact}) {
+    AdaptiveOptions options = fixedCosts(scene);
+    const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 48, options);
+    Sampler single(testDevice(), scene, config);
+    Rendering expected = render(single, method, options, 48, 5);
+    // Fails at its second tile: in the pilot of the adaptive methods, after it ran a
+    // tile whose running sums only it held.
+    auto tiled = withFailingMember(scene, config, {0, 2});
+    Rendering r = render(*tiled, method, options, 48, 5);
+    INFO(methodName(method));
+    CHECK(sameBits(expected.image, r.image));
+    CHECK(expected.alpha == r.alpha);
+    REQUIRE(r.devices.size() == 2);
+    CHECK(r.devices[1].failure == "injected failure");
+    CHECK(r.devices[0].failure.empty());
+  }
+}
+
+TEST_CASE("with every device failed the render stops with a DeviceError", "[devices]") {
+  const Scene scene = smallScene("studio_small_03", "seed000", 40, 26);
+  AdaptiveOptions options = fixedCosts(scene);
+  const SamplerConfig config = samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options);
+  auto tiled = withFailingMember(scene, config, {1, 1});
+  CHECK_THROWS_WITH(render(*tiled, Method::Equal, options, 16, 5), Catch::Contains("every device failed") &&
+                                                                       Catch::Contains("injected failure"));
+}
+
+TEST_CASE("render over a device list reports each device's share and the imbalance", "[devices][cli]") {
+  TempDir dir("devices");
+  auto out = dir.path / "r.exr", report = dir.path / "r.json";
+  auto r = runMisalloc(fmt::format("render --envmap cosk:1 --size 48x32 --spp 16 --method equal --device {} "
+                                   "--out {} --report {} --reference none",
+                                   twoCpuDevices(), out.string(), report.string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  REQUIRE(j["devices"].size() == 2);
+  double share = 0;
+  for (const auto& d : j["devices"]) share += d["pixel_share"].get<double>();
+  CHECK(share == Approx(1.0));
+  CHECK(j["imbalance_s"].get<double>() >= 0);
+  CHECK(j["imbalance_fraction"].get<double>() < 1);
+}
+
+TEST_CASE("device lists that name nothing are refused", "[devices][cli][bad-input]") {
+  TempDir dir("devices-bad");
+  auto out = dir.path / "r.exr";
+  for (const char* list : {"cpu,", "cpu:0", "cpu:x", "cpu:1000", "nonsense"}) {
+    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 --method equal --device {} --out {} --reference none", list,
+                                     out.string()));
+    INFO(list << ": " << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find("--device") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out));
+  }
+}
