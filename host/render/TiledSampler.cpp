@@ -55,6 +55,7 @@ StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int fi
   // The running sums of a stage that keeps them live on the member that ran the tile
   // until shareStatistics: a member that fails loses every tile it ran.
   const bool losesTiles = plan.keepStatistics && keepsStatistics(config_);
+  if (losesTiles) loadMembers(members_.size());
   std::vector<std::vector<PixelRange>> ran(D);
   std::vector<Clock::time_point> lastFinish(D);
   std::exception_ptr programmingError;  // not a device's failure: rethrown as it is
@@ -119,11 +120,11 @@ StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int fi
   }
   if (first != Clock::time_point::max()) imbalanceSeconds_ += seconds(first, last);
   out.kernelSeconds = seconds(start, last);
-  if (losesTiles) shareStatistics(ran);
+  if (losesTiles) gatherStatistics(ran);
   return out;
 }
 
-void TiledSampler::shareStatistics(const std::vector<std::vector<PixelRange>>& ran) {
+void TiledSampler::gatherStatistics(const std::vector<std::vector<PixelRange>>& ran) {
   const int slots = statSlots(), M = scene_.techniqueCount();
   for (size_t d = 0; d < members_.size(); ++d) {
     if (ran[d].empty()) continue;
@@ -141,20 +142,26 @@ void TiledSampler::shareStatistics(const std::vector<std::vector<PixelRange>>& r
       }
     }
   }
-  loadStatistics(stats_);
-  loadStoredSamples(samples_);
+  std::fill(loaded_.begin(), loaded_.end(), 0);
+}
+
+void TiledSampler::loadMembers(size_t count) {
+  for (size_t d = 0; d < count; ++d) {
+    if (!live(d) || loaded_[d]) continue;
+    if (!stats_.empty()) members_[d]->loadStatistics(stats_);
+    if (!samples_.empty()) members_[d]->loadStoredSamples(samples_);
+    loaded_[d] = 1;
+  }
 }
 
 void TiledSampler::loadStatistics(const std::vector<double>& stats) {
   stats_ = stats;
-  for (size_t d = 0; d < members_.size(); ++d)
-    if (live(d)) members_[d]->loadStatistics(stats_);
+  std::fill(loaded_.begin(), loaded_.end(), 0);
 }
 
 void TiledSampler::loadStoredSamples(const std::vector<float>& samples) {
   samples_ = samples;
-  for (size_t d = 0; d < members_.size(); ++d)
-    if (live(d)) members_[d]->loadStoredSamples(samples_);
+  std::fill(loaded_.begin(), loaded_.end(), 0);
 }
 
 GridSearchResult TiledSampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
@@ -163,12 +170,14 @@ GridSearchResult TiledSampler::search(const StoredSampleLayout& layout, const st
   if (!live(0))
     throw DeviceError(fmt::format("{} runs the grid search and failed: {}", members_[0]->deviceShares().front().name,
                                   failures_[0]));
+  loadMembers(1);
   return members_[0]->search(layout, costs, rule, pooling);
 }
 
 void TiledSampler::forgetStages() {
   for (size_t d = 0; d < members_.size(); ++d)
     if (live(d)) members_[d]->forgetStages();
+  loaded_.assign(members_.size(), 1);  // every member starts from zero sums, as stats_
   stats_.assign(size_t(scene_.pixelCount()) * statSlots(), 0.0);
   samples_ = config_.sampleCapacity > 0 ? emptyStoredSamples(scene_, config_.sampleCapacity) : std::vector<float>{};
   imbalanceSeconds_ = 0;

@@ -12,9 +12,9 @@ namespace misalloc {
 // numbers are keyed on the pixel (kernels/rng.h) and its sums run in the same order
 // wherever it runs, so the image is the one a single device of the same arithmetic
 // makes, bit for bit. Each member keeps whole-image running sums and stored samples;
-// after a stage that keeps statistics, the rows each member ran are gathered here and
-// loaded into every member, so that any device can run any pixel in the next stage.
-// The grid searches run on the first member, which holds every stored sample then.
+// after a stage that keeps statistics, the rows each member ran are gathered here, and
+// loaded into every member before the next such stage, so that any device can run any
+// pixel, and into the first member before a grid search, which runs there.
 //
 // A member that fails (an OpenCL error) is retired: its tile, and every tile it ran in
 // a stage whose running sums it alone holds, run again on the others, and its report
@@ -41,14 +41,17 @@ class TiledSampler : public StageSampler {
   void forgetStages() override;
 
   bool live(size_t member) const { return failures_[member].empty(); }
-  // Gathers the rows each member ran in the stage and loads them into every member.
-  void shareStatistics(const std::vector<std::vector<PixelRange>>& ran);
+  // Gathers the rows each member ran in the stage into stats_ and samples_.
+  void gatherStatistics(const std::vector<std::vector<PixelRange>>& ran);
+  // Loads stats_ and samples_ into the first `count` live members that lack them.
+  void loadMembers(size_t count);
 
   std::vector<std::unique_ptr<StageSampler>> members_;
   std::vector<double> sampleRates_;     // samples per second of each member, 0 until measured
   std::vector<std::string> failures_;   // per member: why it was retired, empty while it runs
   std::vector<double> stats_;           // every pixel's running sums after the last stage
   std::vector<float> samples_;          // and its stored samples
+  std::vector<unsigned char> loaded_;   // per member: it holds stats_ and samples_
   double imbalanceSeconds_ = 0;         // Σ over stages: last finish − first finish
 };
 
