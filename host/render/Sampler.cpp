@@ -8,6 +8,7 @@
 #include "Constants.h"
 #include "Error.h"
 #include "KernelCode.h"
+#include "cl/KernelArgs.h"
 
 namespace misalloc {
 namespace {
@@ -209,27 +210,10 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   const std::vector<int32_t> order = coherentPixelOrder(plan, range);
   queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
-  int a = 0;
-  kernel.setArg(a++, texels_);
-  kernel.setArg(a++, cdfTable_);
-  kernel.setArg(a++, aliasTable_);
-  kernel.setArg(a++, cl_int(scene_.tables.width));
-  kernel.setArg(a++, cl_int(scene_.tables.height));
-  kernel.setArg(a++, brdfParams_);
-  for (float m : scene_.mirror) kernel.setArg(a++, m);
-  kernel.setArg(a++, counts_);
-  kernel.setArg(a++, firstIndex_);
-  kernel.setArg(a++, cl_int(plan.stageSamples));
-  kernel.setArg(a++, cl_uint(seed & 0xffffffffu));
-  kernel.setArg(a++, cl_uint(seed >> 32));
-  kernel.setArg(a++, cl_int(range.size()));
-  kernel.setArg(a++, pixelOrder_);
-  kernel.setArg(a++, rgb_);
-  kernel.setArg(a++, moments_);
-  kernel.setArg(a++, stats_);
-  kernel.setArg(a++, samples_);
-  kernel.setArg(a++, cl_int(firstSlot));
-  kernel.setArg(a++, cl_int(config_.sampleCapacity));
+  bindKernelArgs(kernel, texels_, cdfTable_, aliasTable_, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
+                 brdfParams_, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
+                 cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(range.size()),
+                 pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);
