@@ -15,6 +15,26 @@ typedef struct {
   ma_uint first0, first1, first2;  // index of each technique's first sample this stage
 } StageCounts;
 
+// A pixel's StageCounts from the stage's per-pixel arrays ([pixel·M + k]), as the
+// kernel and its C++ reference both read them.
+MA_FN StageCounts loadStageCounts(MA_GLOBAL const int* counts, MA_GLOBAL const ma_uint* firstIndex, int pixel,
+                                  int techniqueCount, int stageSamples, int oneSample, int countIndependent) {
+  MA_GLOBAL const int* n = counts + pixel * techniqueCount;
+  MA_GLOBAL const ma_uint* first = firstIndex + pixel * techniqueCount;
+  StageCounts c;
+  c.techniqueCount = techniqueCount;
+  c.stageSamples = stageSamples;
+  c.oneSample = oneSample;
+  c.countIndependent = countIndependent;
+  c.n0 = n[0];
+  c.n1 = n[1];
+  c.n2 = techniqueCount > 2 ? n[techniqueCount - 1] : 0;
+  c.first0 = first[0];
+  c.first1 = first[1];
+  c.first2 = techniqueCount > 2 ? first[techniqueCount - 1] : 0u;
+  return c;
+}
+
 // The index of `technique`'s first sample this stage (its random-number stream).
 MA_FN ma_uint firstIndexOf(StageCounts c, int technique) {
   return technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);

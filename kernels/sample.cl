@@ -44,19 +44,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   b.rhoS = brdfParams[4 * pixel + 1];
   b.n = brdfParams[4 * pixel + 2];
 
-  __global const int* n = counts + pixel * MA_TECHNIQUES;
-  __global const uint* first = firstIndex + pixel * MA_TECHNIQUES;
-  StageCounts c;
-  c.techniqueCount = MA_TECHNIQUES;
-  c.stageSamples = stageSamples;
-  c.oneSample = MA_ONE_SAMPLE;
-  c.countIndependent = MA_COUNT_INDEPENDENT;
-  c.n0 = n[0];
-  c.n1 = n[1];
-  c.n2 = MA_TECHNIQUES > 2 ? n[MA_TECHNIQUES - 1] : 0;
-  c.first0 = first[0];
-  c.first1 = first[1];
-  c.first2 = MA_TECHNIQUES > 2 ? first[MA_TECHNIQUES - 1] : 0u;
+  StageCounts c = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                  MA_COUNT_INDEPENDENT);
 #if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
 #else

@@ -57,19 +57,9 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     b.rhoD = p.rhoD;
     b.rhoS = p.rhoS;
     b.n = p.n;
-    const int32_t* n = plan.counts.data() + size_t(pixel) * M;
-    const uint32_t* first = plan.firstIndex.data() + size_t(pixel) * M;
-    kern::StageCounts c;
-    c.techniqueCount = M;
-    c.stageSamples = plan.stageSamples;
-    c.oneSample = config_.estimator == Estimator::OneSample;
-    c.countIndependent = config_.estimator == Estimator::CountIndependent;
-    c.n0 = n[0];
-    c.n1 = n[1];
-    c.n2 = M > 2 ? n[M - 1] : 0;
-    c.first0 = first[0];
-    c.first1 = first[1];
-    c.first2 = M > 2 ? first[M - 1] : 0u;
+    const kern::StageCounts c =
+        kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
+                              config_.estimator == Estimator::OneSample, config_.estimator == Estimator::CountIndependent);
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {
