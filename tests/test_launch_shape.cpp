@@ -38,13 +38,13 @@ bool hasFp64(const cl::Device& device) {
 
 }  // namespace
 
-TEST_CASE("sampleStage's local memory: 9 sums, the running sums, the pass counts", "[launch]") {
+TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pass counts", "[launch]") {
   CHECK(sampleKernelLocalBytes(8, 0, true) == 8 * (9 * 8 + 4));
   CHECK(sampleKernelLocalBytes(256, 15, true) == 256 * (24 * 8 + 4));
   CHECK(sampleKernelLocalBytes(64, 6, false) == 64 * (15 * 4 + 4));
 }
 
-TEST_CASE("a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
+TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
   const int few = statSlotsOf(Method::Heuristic, false), many = statSlotsOf(Method::Linear, true);
   REQUIRE(few == 6);
   REQUIRE(many == 15);
@@ -59,7 +59,7 @@ TEST_CASE("a 48 KiB GPU runs 256 work-items with few running sums, fewer with ma
         "48 KiB");
 }
 
-TEST_CASE("a GPU's work-group limit and lockstep width bound the size", "[launch]") {
+TEST_CASE("launch shape: a GPU's work-group limit and lockstep width bound the size", "[launch]") {
   LaunchShape capped = chooseLocalSize(gpu(64), sampleBytes(0));
   CHECK(capped.localSize == 64);
   CHECK(capped.why == "GPU: 64 work-items, 4.8 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
@@ -71,14 +71,14 @@ TEST_CASE("a GPU's work-group limit and lockstep width bound the size", "[launch
   CHECK_THROWS_AS(chooseLocalSize(gpu(1024, 16), sampleBytes(0)), DeviceError);
 }
 
-TEST_CASE("a CPU runs 8 work-items (docs/pocl.md rule 4)", "[launch]") {
+TEST_CASE("launch shape: a CPU runs 8 work-items (docs/pocl.md rule 4)", "[launch]") {
   DeviceLimits cpu{true, 4096, 4u << 20, 1};
   LaunchShape shape = chooseLocalSize(cpu, sampleBytes(15));
   CHECK(shape.localSize == 8);
   CHECK(shape.why.rfind("CPU: 8 work-items", 0) == 0);
 }
 
-TEST_CASE("--local-size is taken if it fits and refused naming the limit if not", "[launch]") {
+TEST_CASE("launch shape: --local-size is taken if it fits and refused naming the limit if not", "[launch]") {
   LaunchShape given = chooseLocalSize(gpu(), sampleBytes(15), 64);
   CHECK(given.localSize == 64);
   CHECK(given.why == "GPU: 64 work-items as --local-size asked, 12.2 KiB of 48 KiB local memory");
@@ -96,7 +96,7 @@ TEST_CASE("--local-size is taken if it fits and refused naming the limit if not"
   CHECK_THROWS_AS(chooseLocalSize(gpu(), sampleBytes(0), -1), InputError);
 }
 
-TEST_CASE("PoCL's CPU device: its limits, and 8 work-items", "[launch]") {
+TEST_CASE("launch shape: PoCL's CPU device: its limits, and 8 work-items", "[launch]") {
   DeviceLimits limits = deviceLimits(testDevice().device);
   CHECK(limits.cpu);
   CHECK(limits.maxWorkGroupSize >= 8);
@@ -105,7 +105,7 @@ TEST_CASE("PoCL's CPU device: its limits, and 8 work-items", "[launch]") {
   CHECK(chooseLocalSize(limits, sampleBytes(15)).localSize == 8);
 }
 
-TEST_CASE("sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
+TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
   const Device& device = testDevice();
   const bool doubleSums = hasFp64(device.device);
   for (bool split : {false, true}) {
