@@ -75,19 +75,19 @@ LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size
     return {overrideLocalSize, fmt::format("{}: {} work-items as --local-size asked, {} of {} local memory", kind,
                                            overrideLocalSize, kib(bytes), kib(limits.localMemBytes))};
   }
-  std::vector<int> preferred;
+  std::vector<int> candidates;
   if (limits.cpu) {
-    preferred.push_back(kCpuLocalSize);
+    candidates.push_back(kCpuLocalSize);
   } else {
     for (int size : kGpuLocalSizes)
-      if (size_t(size) % std::max<size_t>(limits.preferredMultiple, 1) == 0) preferred.push_back(size);
+      if (size_t(size) % std::max<size_t>(limits.preferredMultiple, 1) == 0) candidates.push_back(size);
   }
   // Below the preferred sizes lanes go idle, but the kernel still runs.
-  const int below = preferred.empty() ? kGpuLocalSizes[0] : preferred.back() / 2;
-  for (int size = below; size >= 1; size /= 2) preferred.push_back(size);
+  const int below = candidates.empty() ? kGpuLocalSizes[0] : candidates.back() / 2;
+  for (int size = below; size >= 1; size /= 2) candidates.push_back(size);
 
   std::optional<std::string> refused;  // why the next larger size did not fit
-  for (int size : preferred) {
+  for (int size : candidates) {
     const size_t bytes = localBytes(size);
     if (auto why = misfit(limits, bytes, size)) {
       refused = why;
