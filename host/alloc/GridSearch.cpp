@@ -397,6 +397,10 @@ WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::ve
   return grid;
 }
 
+std::string gridSearchKernelOptions(int techniqueCount) {
+  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors);
+}
+
 std::size_t StoredSampleLayout::floatCount() const {
   return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
@@ -414,9 +418,7 @@ int GridSearchResult::fallbackCount() const {
 GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize)
     : device_(device), techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
   const std::size_t sumFloats = runningSumFloats(techniqueCount, gridSize);
-  cl::Program program =
-      buildProgram(device, "gridsearch.cl",
-                   fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors));
+  cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(techniqueCount));
   kernel_ = cl::Kernel(program, "gridSearch");
   poolKernel_ = cl::Kernel(program, "selectPooled");
   // OpenCL buffers cannot be empty.

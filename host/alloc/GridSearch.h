@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "alloc/Allocation.h"
@@ -45,6 +46,10 @@ struct WeightGrid {
 // Throws std::invalid_argument for M outside 2..kMaxTechniques, a size < 1 or an
 // invalid cost (validateCosts).
 WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::vector<double>& costs);
+
+// The `-D` options that compile kernels/gridsearch.cl for M techniques. The grid, its
+// rule and the pooling are kernel arguments: one program serves them all.
+std::string gridSearchKernelOptions(int techniqueCount);
 
 // Where the stored samples are: the blocked float layout of kernels/stats.h
 // (storedSampleIndex), `capacity` slots per pixel of which the first `taken` are filled

@@ -1,0 +1,49 @@
+#pragma once
+// The work-group size of the sampling kernel (kernels/sample.cl) on a given device:
+// PoCL's CPU device vectorises best at 8 work-items (docs/pocl.md, rule 4), a GPU wants
+// 64–256, and sampleStage's local memory grows with the work-group and the running sums.
+#include <CL/opencl.hpp>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace misalloc {
+
+// What a device allows a work-group.
+struct DeviceLimits {
+  bool cpu = false;
+  size_t maxWorkGroupSize = 0;  // CL_DEVICE_MAX_WORK_GROUP_SIZE
+  uint64_t localMemBytes = 0;   // CL_DEVICE_LOCAL_MEM_SIZE
+  // Work-items that run in lockstep (a warp, a wavefront): a work-group of a multiple of
+  // it leaves no lane idle. 1 where it does not matter (CPU).
+  size_t preferredMultiple = 1;
+};
+
+// A GPU's preferred multiple is its warp (cl_nv_device_attribute_query) or wavefront
+// (cl_amd_device_attribute_query) width where the device reports it, else 32: the
+// kernel-free OpenCL 1.2 queries say nothing about it.
+DeviceLimits deviceLimits(const cl::Device& device);
+
+// The local memory of sampleStage at this work-group size: its sums, running sums
+// (`statSlots`, StageSampler::statSlots()) and pass counts, in double where
+// `doubleSums` (ma_acc, kernels/common.h) else float. With no running sums the kernel
+// declares a one-row placeholder that it never touches: PoCL and clang's nvptx64
+// back end both drop it, so it is not counted.
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums);
+
+struct LaunchShape {
+  int localSize = 0;
+  std::string why;  // one line for the report
+};
+
+// CPU: 8. Otherwise the largest of 256, 128, 64, 32 that is a multiple of
+// preferredMultiple, at most maxWorkGroupSize and whose localBytes(size) fit
+// localMemBytes; failing all of them, the largest smaller power of two that fits.
+// overrideLocalSize > 0 (--local-size) is taken as given if it fits the limits.
+// Throws InputError for an override that does not fit, naming --local-size, the limit
+// and the bytes it needs, and DeviceError if not even one work-item fits.
+LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,
+                            int overrideLocalSize = 0);
+
+}  // namespace misalloc

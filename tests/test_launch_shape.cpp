@@ -1,0 +1,125 @@
+// The sampling kernel's work-group size per device (host/cl/LaunchShape.h): fake GPU and
+// CPU limits, --local-size overrides, PoCL's real limits, and the local-memory formula
+// against what PoCL reports for the built kernel.
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "Error.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "cl/LaunchShape.h"
+#include "render/Render.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+constexpr uint64_t k48KiB = 48 * 1024;
+
+DeviceLimits gpu(size_t maxWorkGroupSize = 1024, uint64_t localMemBytes = k48KiB, size_t preferredMultiple = 32) {
+  return DeviceLimits{false, maxWorkGroupSize, localMemBytes, preferredMultiple};
+}
+
+// The running sums of a method's sampler on a scene of M techniques.
+int statSlotsOf(Method method, bool split) {
+  Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split);
+  HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, 64, AdaptiveOptions{}));
+  return sampler.statSlots();
+}
+
+std::function<size_t(int)> sampleBytes(int statSlots) {
+  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true); };
+}
+
+bool hasFp64(const cl::Device& device) {
+  return device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pass counts", "[launch]") {
+  CHECK(sampleKernelLocalBytes(8, 0, true) == 8 * (9 * 8 + 4));
+  CHECK(sampleKernelLocalBytes(256, 15, true) == 256 * (24 * 8 + 4));
+  CHECK(sampleKernelLocalBytes(64, 6, false) == 64 * (15 * 4 + 4));
+}
+
+TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
+  const int few = statSlotsOf(Method::Heuristic, false), many = statSlotsOf(Method::Linear, true);
+  REQUIRE(few == 6);
+  REQUIRE(many == 15);
+  LaunchShape wide = chooseLocalSize(gpu(), sampleBytes(few));
+  CHECK(wide.localSize == 256);
+  CHECK(wide.why == "GPU: 256 work-items, 31 KiB of 48 KiB local memory");
+  // 256 × (24 doubles + an int) = 49 KiB: one KiB over.
+  LaunchShape narrow = chooseLocalSize(gpu(), sampleBytes(many));
+  CHECK(narrow.localSize == 128);
+  CHECK(narrow.why ==
+        "GPU: 128 work-items, 24.5 KiB of 48 KiB local memory; 256 would need 49 KiB of local memory, the device has "
+        "48 KiB");
+}
+
+TEST_CASE("launch shape: a GPU's work-group limit and lockstep width bound the size", "[launch]") {
+  LaunchShape capped = chooseLocalSize(gpu(64), sampleBytes(0));
+  CHECK(capped.localSize == 64);
+  CHECK(capped.why == "GPU: 64 work-items, 4.8 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
+                      "per group");
+  // A wavefront of 64 skips 32; below every preferred size the largest that fits runs.
+  CHECK(chooseLocalSize(gpu(1024, k48KiB, 64), sampleBytes(0)).localSize == 256);
+  CHECK(chooseLocalSize(gpu(1024, 4096, 64), sampleBytes(0)).localSize == 32);
+  CHECK(chooseLocalSize(gpu(16), sampleBytes(0)).localSize == 16);
+  CHECK_THROWS_AS(chooseLocalSize(gpu(1024, 16), sampleBytes(0)), DeviceError);
+}
+
+TEST_CASE("launch shape: a CPU runs 8 work-items (docs/pocl.md rule 4)", "[launch]") {
+  DeviceLimits cpu{true, 4096, 4u << 20, 1};
+  LaunchShape shape = chooseLocalSize(cpu, sampleBytes(15));
+  CHECK(shape.localSize == 8);
+  CHECK(shape.why.rfind("CPU: 8 work-items", 0) == 0);
+}
+
+TEST_CASE("launch shape: --local-size is taken if it fits and refused naming the limit if not", "[launch]") {
+  LaunchShape given = chooseLocalSize(gpu(), sampleBytes(15), 64);
+  CHECK(given.localSize == 64);
+  CHECK(given.why == "GPU: 64 work-items as --local-size asked, 12.2 KiB of 48 KiB local memory");
+  try {
+    chooseLocalSize(gpu(), sampleBytes(15), 256);
+    FAIL("an override that needs more local memory than the device has was taken");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) ==
+          "--local-size 256: the sampling kernel does not fit this GPU: 256 would need 49 KiB of local memory, the "
+          "device has 48 KiB");
+  }
+  CHECK_THROWS_WITH(chooseLocalSize(gpu(512), sampleBytes(0), 1024),
+                    "--local-size 1024: the sampling kernel does not fit this GPU: 1024 exceeds the device's 512 "
+                    "work-items per group");
+  CHECK_THROWS_AS(chooseLocalSize(gpu(), sampleBytes(0), -1), InputError);
+}
+
+TEST_CASE("launch shape: PoCL's CPU device: its limits, and 8 work-items", "[launch]") {
+  DeviceLimits limits = deviceLimits(testDevice().device);
+  CHECK(limits.cpu);
+  CHECK(limits.maxWorkGroupSize >= 8);
+  CHECK(limits.localMemBytes > 0);
+  CHECK(limits.preferredMultiple == 1);
+  CHECK(chooseLocalSize(limits, sampleBytes(15)).localSize == 8);
+}
+
+TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
+  const Device& device = testDevice();
+  const bool doubleSums = hasFp64(device.device);
+  for (bool split : {false, true}) {
+    Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split);
+    for (Method method : {Method::Equal, Method::Heuristic, Method::Linear}) {
+      SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 64, AdaptiveOptions{});
+      const int statSlots = HostSampler(scene, config).statSlots();
+      for (int localSize : {8, 64}) {
+        CAPTURE(split, methodName(method), localSize);
+        cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)),
+                          "sampleStage");
+        CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
+              sampleKernelLocalBytes(localSize, statSlots, doubleSums));
+      }
+    }
+  }
+}
