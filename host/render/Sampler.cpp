@@ -9,6 +9,7 @@
 #include "Error.h"
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
+#include "cl/LaunchShape.h"
 
 namespace misalloc {
 namespace {
@@ -125,14 +126,21 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 }
 
 Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize)
-    : StageSampler(scene, config), device_(device), localSize_(localSize) {
-  if (localSize < 1) throw InputError("--local-size must be at least 1");
+    : StageSampler(scene, config), device_(device) {
+  if (localSize < 0) throw InputError("--local-size must be at least 1, or 0 to choose per device");
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
-  kernel_ = cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
-  plainKernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl",
-                                                                   sampleKernelOptions(scene, plainConfig(config), localSize)),
-                                                      "sampleStage")
-                                         : kernel_;
+  // Both kernels run at one size: that of the one with the running sums, the larger.
+  const LaunchShape shape = chooseLocalSize(
+      deviceLimits(device.device), [&](int size) { return sampleKernelLocalBytes(size, statSlots(), doubleSums_); },
+      localSize);
+  localSize_ = shape.localSize;
+  share_.launch = shape.why;
+  kernel_ =
+      cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize_)), "sampleStage");
+  plainKernel_ = keepsStatistics(config)
+                     ? cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, plainConfig(config), localSize_)),
+                                  "sampleStage")
+                     : kernel_;
   const EnvmapTables& t = scene.tables;
   texels_ = upload(device, t.texels);
   cdfTable_ = upload(device, t.cdfTable);
@@ -157,7 +165,6 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * 3 * accSize);
   moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
   share_.name = device.name();
-  share_.launch = fmt::format("local size {}", localSize);
   if (config.gridSize > 0)
     gridSearch_ = std::make_unique<GridSearch>(device, scene.techniqueCount(), scene.pixelCount(), config.gridSize);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,

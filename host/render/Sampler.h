@@ -87,7 +87,9 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 // scene uploaded once; each run() takes one stage for every pixel.
 class Sampler : public StageSampler {
  public:
-  Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 8);
+  // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
+  Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0);
+  int localSize() const { return localSize_; }
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
   std::vector<DeviceShare> deviceShares() const override;
