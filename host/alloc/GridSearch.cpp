@@ -9,6 +9,7 @@
 
 #include "Constants.h"
 #include "KernelCode.h"
+#include "cl/KernelArgs.h"
 namespace misalloc::kern {
 #include "gridsearch.h"
 }  // namespace misalloc::kern
@@ -472,25 +473,9 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
   cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
   cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
-  int a = 0;
-  kernel_.setArg(a++, samples);
-  kernel_.setArg(a++, cl_int(layout.capacity));
-  kernel_.setArg(a++, cl_int(layout.taken));
-  kernel_.setArg(a++, cl_int(pixels));
-  kernel_.setArg(a++, gridLanes);
-  kernel_.setArg(a++, gridCost);
-  kernel_.setArg(a++, cl_int(grid.size()));
-  kernel_.setArg(a++, cl_int(lanes.paddedSize));
-  kernel_.setArg(a++, cost);
-  kernel_.setArg(a++, cl_int(kernelRule(rule)));
-  kernel_.setArg(a++, prepared_);
-  kernel_.setArg(a++, summaries_);
-  kernel_.setArg(a++, sums_);
-  kernel_.setArg(a++, alphaOut);
-  kernel_.setArg(a++, selectedOut);
-  kernel_.setArg(a++, fallbacksOut);
-  kernel_.setArg(a++, scores_);
-  kernel_.setArg(a++, scales_);
+  bindKernelArgs(kernel_, samples, cl_int(layout.capacity), cl_int(layout.taken), cl_int(pixels), gridLanes, gridCost,
+                 cl_int(grid.size()), cl_int(lanes.paddedSize), cost, cl_int(kernelRule(rule)), prepared_, summaries_,
+                 sums_, alphaOut, selectedOut, fallbacksOut, scores_, scales_);
   cl::Event done;
   const int blocks = int(paddedPixelCount(std::size_t(pixels)) / kPixelBlock);
   device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange,
@@ -506,18 +491,10 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     selectedFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
     fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
     cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
-    a = 0;
-    for (const cl::Buffer* b : {&scores_, &scales_, &alphaOut, &selectedOut, &fallbacksOut})
-      poolKernel_.setArg(a++, *b);
-    poolKernel_.setArg(a++, cl_int(pooling->width));
-    poolKernel_.setArg(a++, cl_int(pooling->height));
-    poolKernel_.setArg(a++, cl_int(pooling->radius));
-    poolKernel_.setArg(a++, gridLanes);
-    poolKernel_.setArg(a++, cl_int(grid.size()));
-    poolKernel_.setArg(a++, cl_int(lanes.paddedSize));
-    poolKernel_.setArg(a++, cl_int(nearestEqual(grid)));
-    poolKernel_.setArg(a++, cl_float(pooling->minGain));
-    for (const cl::Buffer* b : {&alphaFinal, &selectedFinal, &fallbacksFinal, &skippedOut}) poolKernel_.setArg(a++, *b);
+    bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, cl_int(pooling->width),
+                   cl_int(pooling->height), cl_int(pooling->radius), gridLanes, cl_int(grid.size()),
+                   cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)), cl_float(pooling->minGain), alphaFinal,
+                   selectedFinal, fallbacksFinal, skippedOut);
     cl::Event pooled;
     device_.queue.enqueueNDRangeKernel(poolKernel_, cl::NullRange,
                                        cl::NDRange((std::size_t(pixels) + kPoolLocalSize - 1) / kPoolLocalSize *
