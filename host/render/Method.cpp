@@ -67,12 +67,6 @@ std::string methodName(Method method) { return methodTraits(method).name; }
 
 bool isAdaptive(Method method) { return methodTraits(method).adaptive(); }
 
-Estimator methodEstimator(Method method) { return methodTraits(method).estimator; }
-
-unsigned methodStatistics(Method method) { return methodTraits(method).statistics; }
-
-bool methodStoresSamples(Method method) { return methodTraits(method).storesSamples; }
-
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel) {
   const int M = scene.techniqueCount();
   std::vector<int> counts(M, 0);

@@ -50,9 +50,6 @@ const std::vector<Method>& allMethods();
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);
 bool isAdaptive(Method method);
-Estimator methodEstimator(Method method);
-unsigned methodStatistics(Method method);
-bool methodStoresSamples(Method method);
 
 // Counts n_k for one pixel of a fixed split, Σ_k n_k = spp. Single-technique methods
 // give the others 0; with the BRDF split into lobes, `brdf` shares its samples by
