@@ -85,7 +85,7 @@ TEST_CASE("launch shape: --local-size is taken if it fits and refused naming the
   try {
     chooseLocalSize(gpu(), sampleBytes(15), 256);
     FAIL("an override that needs more local memory than the device has was taken");
-  } catch (const InputError& e) {
+  } catch (const DeviceError& e) {
     CHECK(std::string(e.what()) ==
           "--local-size 256: the sampling kernel does not fit this GPU: 256 would need 49 KiB of local memory, the "
           "device has 48 KiB");

@@ -70,7 +70,7 @@ LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size
   if (overrideLocalSize > 0) {
     const size_t bytes = localBytes(overrideLocalSize);
     if (auto why = misfit(limits, bytes, overrideLocalSize))
-      throw InputError(fmt::format("--local-size {}: the sampling kernel does not fit this {}: {}", overrideLocalSize,
+      throw DeviceError(fmt::format("--local-size {}: the sampling kernel does not fit this {}: {}", overrideLocalSize,
                                    kind, *why));
     return {overrideLocalSize, fmt::format("{}: {} work-items as --local-size asked, {} of {} local memory", kind,
                                            overrideLocalSize, kib(bytes), kib(limits.localMemBytes))};

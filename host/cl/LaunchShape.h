@@ -41,8 +41,9 @@ struct LaunchShape {
 // preferredMultiple, at most maxWorkGroupSize and whose localBytes(size) fit
 // localMemBytes; failing all of them, the largest smaller power of two that fits.
 // overrideLocalSize > 0 (--local-size) is taken as given if it fits the limits.
-// Throws InputError for an override that does not fit, naming --local-size, the limit
-// and the bytes it needs, and DeviceError if not even one work-item fits.
+// Throws DeviceError for an override that does not fit this device (exit code 3, as
+// every limit of a device an option exceeds), naming --local-size, the limit and the
+// bytes it needs, and if not even one work-item fits.
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,
                             int overrideLocalSize = 0);
 

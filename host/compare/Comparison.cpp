@@ -132,10 +132,11 @@ void validateCompareOptions(const CompareOptions& options) {
     if (!options.adaptive.costs.empty() && int(options.adaptive.costs.size()) != M)
       throw InputError(fmt::format("--cost: {} needs {} costs", c.label, M));
     for (Method m : options.methods) {
-      if (m == Method::Oracle && options.adaptive.oracleSamples < 2 * M)
+      const MethodTraits& traits = methodTraits(m);
+      if (traits.split == Split::Probed && options.adaptive.oracleSamples < 2 * M)
         throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
                                      options.adaptive.oracleSamples));
-      if (isAdaptive(m) && m != Method::Oracle)
+      if (traits.split == Split::Staged)
         for (int budget : options.budgets)
           stageSizes(options.adaptive.pilotFraction, options.adaptive.stages, budget, M);
     }

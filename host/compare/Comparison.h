@@ -26,7 +26,7 @@ struct CompareOptions {
   int tableBudget = 200;     // the spp of the Table 5.2 layout (the nearest budget)
   AdaptiveOptions adaptive;  // costs empty: measured per case
   std::string device = "auto";
-  int localSize = 8;
+  int localSize = 0;  // 0: each device's own (cl/LaunchShape.h)
   int referenceSpp = 16384;
   std::string cacheDir;
   std::string outDir;

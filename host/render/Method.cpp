@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <iterator>
 
 #include "Error.h"
 #include "KernelCode.h"
@@ -10,21 +11,32 @@
 namespace misalloc {
 namespace {
 
-struct MethodName {
-  Method method;
-  const char* name;
+constexpr Estimator kBalance = Estimator::MultiSample;
+
+// One row per method, in the enum's order, which is the order of the tables.
+constexpr MethodTraits kMethods[] = {
+    // method, name, split, searches weights, estimator, statistics, stores samples
+    {Method::Envmap, "envmap", Split::Fixed, false, kBalance, 0, false},
+    {Method::Brdf, "brdf", Split::Fixed, false, kBalance, 0, false},
+    {Method::Equal, "equal", Split::Fixed, false, kBalance, 0, false},
+    // [HS14] eq. 4.20 from V_k, eq. 4.18
+    {Method::Heuristic, "heuristic", Split::Staged, false, kBalance, MA_STATS_TECHNIQUE, false},
+    // [SHS16] eq. 31 from σ_k, eq. 28
+    {Method::SigmaSqrtC, "sigma-sqrt-c", Split::Staged, false, Estimator::CountIndependent, MA_STATS_BALANCE, false},
+    // [SS23] eq. 14; its negative weights by eq. 19 need the samples
+    {Method::Linear, "linear", Split::Staged, false, kBalance, MA_STATS_LINEAR, true},
+    // The grid search reads each stage's samples into sums of its own, per combination.
+    {Method::Exact, "exact", Split::Staged, true, kBalance, 0, true},
+    // The grid search reads the probe's samples.
+    {Method::Oracle, "oracle", Split::Probed, true, kBalance, 0, true},
 };
 
-constexpr MethodName kMethods[] = {
-    {Method::Envmap, "envmap"},
-    {Method::Brdf, "brdf"},
-    {Method::Equal, "equal"},
-    {Method::Heuristic, "heuristic"},
-    {Method::SigmaSqrtC, "sigma-sqrt-c"},
-    {Method::Linear, "linear"},
-    {Method::Exact, "exact"},
-    {Method::Oracle, "oracle"},
-};
+constexpr bool inEnumOrder() {
+  for (size_t i = 0; i < std::size(kMethods); ++i)
+    if (size_t(kMethods[i].method) != i) return false;
+  return true;
+}
+static_assert(inEnumOrder(), "methodTraits indexes kMethods by the enum");
 
 std::string availableMethods() {
   std::vector<std::string> names;
@@ -34,9 +46,14 @@ std::string availableMethods() {
 
 }  // namespace
 
+const MethodTraits& methodTraits(Method method) { return kMethods[size_t(method)]; }
+
 const std::vector<Method>& allMethods() {
-  static const std::vector<Method> methods{Method::Envmap,     Method::Brdf,   Method::Equal, Method::Heuristic,
-                                           Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle};
+  static const std::vector<Method> methods = [] {
+    std::vector<Method> out;
+    for (const auto& m : kMethods) out.push_back(m.method);
+    return out;
+  }();
   return methods;
 }
 
@@ -46,34 +63,9 @@ Method parseMethod(const std::string& name) {
   throw InputError(fmt::format("unknown --method '{}' (available: {})", name, availableMethods()));
 }
 
-std::string methodName(Method method) {
-  for (const auto& m : kMethods)
-    if (method == m.method) return m.name;
-  return "?";
-}
+std::string methodName(Method method) { return methodTraits(method).name; }
 
-bool isAdaptive(Method method) { return method != Method::Envmap && method != Method::Brdf && method != Method::Equal; }
-
-Estimator methodEstimator(Method method) {
-  return method == Method::SigmaSqrtC ? Estimator::CountIndependent : Estimator::MultiSample;
-}
-
-unsigned methodStatistics(Method method) {
-  switch (method) {
-    case Method::Heuristic:
-      return MA_STATS_TECHNIQUE;
-    case Method::SigmaSqrtC:
-      return MA_STATS_BALANCE;
-    case Method::Linear:
-      return MA_STATS_LINEAR;
-    default:
-      return 0;
-  }
-}
-
-bool methodStoresSamples(Method method) {
-  return method == Method::Linear || method == Method::Exact || method == Method::Oracle;
-}
+bool isAdaptive(Method method) { return methodTraits(method).adaptive(); }
 
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel) {
   const int M = scene.techniqueCount();

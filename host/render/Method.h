@@ -7,11 +7,41 @@
 
 namespace misalloc {
 
-// How a pixel's N samples are split among the techniques. The first three are fixed
-// splits taken in one stage; heuristic, sigma-sqrt-c, linear and exact allocate
-// adaptively in batches; oracle (evaluation only) takes the α that a high-sample
-// probe finds best (render/Render.h).
+// How a pixel's N samples are split among the techniques. What each method is, which
+// estimator and statistics it needs, and how its α is found, is one row of the table in
+// Method.cpp (methodTraits).
 enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle };
+
+// Where a method's split comes from.
+enum class Split {
+  // The method's own counts (methodCounts), in one stage.
+  Fixed,
+  // A pilot, then stages, each split by the α of the samples before it (render/Render.h).
+  Staged,
+  // Evaluation only: the α that a probe of samples beyond the budget finds best, then one
+  // stage; a bound on what allocation can reach, not a contender.
+  Probed,
+};
+
+struct MethodTraits {
+  Method method;
+  const char* name;
+  Split split;
+  // α from the grid search over U weight combinations (alloc/GridSearch.h, [HS14]
+  // Algorithm 1); an adaptive method without it has a per-pixel rule from its running
+  // sums or samples (alloc/).
+  bool searchesWeights;
+  // The estimator of an adaptive method's stages: σ/√c allocates for the estimator with
+  // count-independent weights ([SHS16] Sec. 4), everything else for the balance
+  // heuristic. A fixed split takes the estimator asked for.
+  Estimator estimator;
+  unsigned statistics;  // the running sums each pixel keeps (kernels/stats.h)
+  bool storesSamples;   // and the samples themselves
+
+  constexpr bool adaptive() const { return split != Split::Fixed; }
+};
+
+const MethodTraits& methodTraits(Method method);
 
 // Every method, in the order of the tables ([HS14] Table 5.2's rows, then ours).
 const std::vector<Method>& allMethods();
@@ -20,14 +50,6 @@ const std::vector<Method>& allMethods();
 Method parseMethod(const std::string& name);
 std::string methodName(Method method);
 bool isAdaptive(Method method);
-
-// The estimator each method's stages use: σ/√c allocates for the estimator with
-// count-independent weights ([SHS16] Sec. 4); everything else for the balance heuristic.
-Estimator methodEstimator(Method method);
-
-// The running sums (kernels/stats.h) and whether the stored samples are needed.
-unsigned methodStatistics(Method method);
-bool methodStoresSamples(Method method);
 
 // Counts n_k for one pixel of a fixed split, Σ_k n_k = spp. Single-technique methods
 // give the others 0; with the BRDF split into lobes, `brdf` shares its samples by

@@ -150,7 +150,7 @@ void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> c
 std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
                                             Progress& progress) {
   const Scene& scene = sampler.scene();
-  if (method == Method::Exact) {
+  if (methodTraits(method).searchesWeights) {
     std::optional<PooledSelection> pooling;
     if (options.gridRule == GridRule::MinCostVariance)
       pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
@@ -161,7 +161,7 @@ std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method
   const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = sampler.statSlots();
   std::vector<double> stats = sampler.statistics();
   poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, options.poolRadius);
-  std::vector<float> stored = methodStoresSamples(method) ? sampler.storedSamples() : std::vector<float>{};
+  std::vector<float> stored = methodTraits(method).storesSamples ? sampler.storedSamples() : std::vector<float>{};
   std::vector<Allocation> allocations(pixels);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int p = 0; p < pixels; ++p) {
@@ -214,15 +214,18 @@ int largestStatisticsStage(const AdaptiveOptions& options, int spp) {
 }  // namespace
 
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options) {
+  const MethodTraits& traits = methodTraits(method);
   SamplerConfig config;
-  config.estimator = isAdaptive(method) ? methodEstimator(method) : fixedSplitEstimator;
-  config.statsMask = methodStatistics(method);
-  config.sampleCapacity = methodStoresSamples(method) ? spp : 0;
-  // The grid searches keep running sums: the samples of one stage at a time are
-  // stored, and the last stage stores none (the oracle's: its probe only).
-  if (method == Method::Exact) config.sampleCapacity = largestStatisticsStage(options, spp);
-  if (method == Method::Oracle) config.sampleCapacity = options.oracleSamples;
-  if (method == Method::Exact || method == Method::Oracle) config.gridSize = options.gridSize;
+  config.estimator = traits.adaptive() ? traits.estimator : fixedSplitEstimator;
+  config.statsMask = traits.statistics;
+  config.sampleCapacity = traits.storesSamples ? spp : 0;
+  if (traits.searchesWeights) {
+    // The grid searches keep running sums: the samples of one stage at a time are
+    // stored, and the last stage stores none (the oracle's: its probe only).
+    config.sampleCapacity =
+        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp);
+    config.gridSize = options.gridSize;
+  }
   return config;
 }
 
@@ -247,7 +250,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   Progress progress(pixels, M);
   if (!isAdaptive(method)) {
     takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, spp, seed, false);
-  } else if (method == Method::Oracle) {
+  } else if (methodTraits(method).split == Split::Probed) {
     validateCosts(options.costs, M);
     // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
     // seed of its own, stands in for the true variance as a function of α; the render
@@ -266,7 +269,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     validateAdaptiveOptions(options);
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
-    if (method == Method::Exact && options.gridRule == GridRule::MinCostVariance)
+    if (methodTraits(method).searchesWeights && options.gridRule == GridRule::MinCostVariance)
       std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
     for (size_t b = 0; b < sizes.size(); ++b) {
       std::vector<int32_t> counts;

@@ -124,14 +124,15 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"skipped_pixels", r.skippedPixels},
         {"skipped_pixel_fraction", double(r.skippedPixels) / pixels},
     };
-    if (run.method == Method::Exact || run.method == Method::Oracle) {
+    if (methodTraits(run.method).searchesWeights) {
       report["allocation"]["grid_u"] = run.adaptive.gridSize;
       report["allocation"]["grid_selection"] =
           run.method == Method::Exact && run.adaptive.gridRule == GridRule::MaxEntropy
               ? "maximum entropy of normalised lambda ([HS14] Alg. 1 line 13)"
               : "minimum cost x multi-sample variance ([SHS16] eq. 21)";
     }
-    if (run.method == Method::Oracle) report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
+    if (methodTraits(run.method).split == Split::Probed)
+      report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
     if (run.method == Method::Linear)
       report["allocation"]["zero_weight_rule"] = run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance
                                                      ? "min sample variance ([SS23] eq. 19)"

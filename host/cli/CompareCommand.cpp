@@ -1,0 +1,153 @@
+// misalloc compare: error against time for methods × budgets × repeats on one scene or
+// the suite, with equal-time tables, plots and index.html.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "AtomicFile.h"
+#include "Error.h"
+#include "NumberList.h"
+#include "OptionRange.h"
+#include "OutputSet.h"
+#include "cli/AdaptiveArgs.h"
+#include "cli/DeviceArgs.h"
+#include "cli/EnvmapInputs.h"
+#include "cli/SceneArgs.h"
+#include "cli/StatisticsMemory.h"
+#include "cli/Subcommand.h"
+#include "compare/CompareReport.h"
+#include "compare/Comparison.h"
+#include "compare/EnvmapPdfComparison.h"
+#include "compare/Suite.h"
+#include "compare/Summary.h"
+#include "compare/SummaryTables.h"
+#include "render/BrdfCoverage.h"
+#include "render/Reference.h"
+
+namespace misalloc {
+namespace {
+
+struct CompareArgs {
+  CLI::App* command = nullptr;
+  SceneArgs scene;
+  AdaptiveArgs adaptive;
+  DeviceArgs devices;
+  CompareOptions compare;
+  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain";
+  bool suite = false;
+};
+
+// "all" or a comma-separated list of method names, each once.
+std::vector<Method> parseMethodList(const std::string& list) {
+  if (list == "all") return allMethods();
+  std::vector<Method> methods;
+  std::stringstream items(list);
+  for (std::string item; std::getline(items, item, ',');) {
+    Method m = parseMethod(item);
+    if (std::find(methods.begin(), methods.end(), m) != methods.end())
+      throw InputError(fmt::format("--methods {}: {} is listed twice", list, item));
+    methods.push_back(m);
+  }
+  return methods;
+}
+
+std::vector<int> parseBudgets(const std::string& list) {
+  std::vector<int> budgets;
+  for (double v : parseNumberList("--budgets", list, list, 0, "expected spp,spp,... in ascending order")) {
+    if (v != std::floor(v) || v < 1 || v > 1e7)
+      throw InputError(fmt::format("--budgets {}: {} is not a whole number of samples per pixel", list, v));
+    budgets.push_back(int(v));
+  }
+  return budgets;
+}
+
+int runCompare(CompareArgs& args) {
+  InterruptionGuard guard;  // first: every thread started from here on inherits its mask
+  CompareOptions& compare = args.compare;
+  if (args.suite) {
+    for (const char* sceneOption : {"--envmap", "--grid", "--envmap-sampler", "--split-brdf"})
+      if (args.command->count(sceneOption) > 0)
+        throw InputError(fmt::format("--suite runs its own scenes: drop {}", sceneOption));
+    if (args.command->count("--size") == 0) args.scene.size = "64x64";
+    Scene probe = args.scene.make();  // checks --size and --view
+    for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
+      c.scene.viewTheta = probe.options.viewTheta;
+      c.scene.viewPhi = probe.options.viewPhi;
+      compare.cases.push_back(c);
+    }
+  } else {
+    Scene probe = args.scene.make();  // reads the envmap once, so bad input fails before any work
+    compare.cases.push_back({caseLabel(probe.options), probe.options});
+  }
+  compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(args.envmapPdfs));
+  compare.methods = parseMethodList(args.methods);
+  compare.budgets = parseBudgets(args.budgets);
+  compare.adaptive = args.adaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
+  compare.device = args.devices.spec();
+  validateCompareOptions(compare);
+  for (const CompareCase& c : compare.cases)
+    for (Method m : compare.methods)
+      for (int budget : compare.budgets)
+        requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, args.devices.onHost());
+  requireBrdfCoverage(compare);
+  std::vector<SceneOptions> scenes;
+  for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
+  OutputSet outputs(envmapInputs(scenes));
+  const std::string outDir = compare.outDir;
+  compare.outDir = outputs.claimFolder("--out-dir", outDir);  // filled as it runs, moved in at the end
+  Comparison comparison = runComparison(compare, guard);
+  Summary summary = summarize(comparison, compare);
+  writeCompareReport(summary, compare.outDir);
+  const std::string envmapPdfTables = envmapPdfMarkdown(summary);
+  if (!envmapPdfTables.empty()) writeFileAtomically(compare.outDir + "/envmap_pdfs.md", envmapPdfTables);
+  outputs.commit();
+  if (comparison.interrupted) {
+    std::cerr << fmt::format("misalloc: interrupted after {} runs; {} holds them, every file complete\n",
+                             comparison.runs.size(), outDir);
+    return 130;
+  }
+  std::cout << summaryMarkdown(summary) << envmapPdfTables;
+  std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n", outDir);
+  return 0;
+}
+
+}  // namespace
+
+Subcommand addCompareCommand(CLI::App& app) {
+  auto args = std::make_shared<CompareArgs>();
+  auto* command = args->command = app.add_subcommand(
+      "compare", "error against time: methods x budgets x repeats, equal-time tables, plots and index.html");
+  CompareOptions& compare = args->compare;
+  args->scene.add(*command);
+  args->adaptive.add(*command);
+  command->add_flag("--suite", args->suite,
+                    "every shipped envmap x seed000 plus forest_slope with the cdf sampler, at 64x64 unless --size");
+  command->add_option("--methods", args->methods, "comma-separated methods, or all")->capture_default_str();
+  command->add_option("--budgets", args->budgets, "samples per pixel, ascending")->capture_default_str();
+  command
+      ->add_option("--envmap-pdfs", args->envmapPdfs, "envmap pdfs, each scene runs with each: plain, compensated[:C]")
+      ->capture_default_str();
+  command->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  command->add_option("--seed", compare.seed, "repeat r uses seed + r")->capture_default_str()->check(anyUnsigned64());
+  command->add_option("--table-spp", compare.tableBudget, "the budget of the Table 5.2 layout (nearest one run)")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  command->add_option("--out-dir", compare.outDir, "output folder (created if missing)")->required();
+  args->devices.add(*command, "comma-separated: auto, cpu, gpu, an index, host (C++), all, or D:N (sub-devices)");
+  command->add_option("--local-size", compare.localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
+  command->add_option("--reference-spp", compare.referenceSpp, "spp of a sampled reference")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  compare.cacheDir = defaultCacheDir();
+  command->add_option("--cache-dir", compare.cacheDir, "where references are cached")->capture_default_str();
+  return {command, [args] { return runCompare(*args); }};
+}
+
+}  // namespace misalloc

@@ -1,0 +1,16 @@
+#include "cli/DeviceArgs.h"
+
+namespace misalloc {
+
+void DeviceArgs::add(CLI::App& command, const std::string& description) {
+  command.add_option("--device", spec_, description)->capture_default_str();
+}
+
+std::unique_ptr<StageSampler> DeviceArgs::makeSampler(const Scene& scene, const SamplerConfig& config, int localSize) {
+  if (!devices_) devices_ = std::make_unique<SamplerDevices>(spec_);
+  return devices_->makeSampler(scene, config, localSize);
+}
+
+std::string DeviceArgs::name() const { return devices_ ? devices_->name() : spec_; }
+
+}  // namespace misalloc

@@ -1,0 +1,54 @@
+// misalloc reference: a converged reference image, found in the cache or computed and
+// cached.
+#include <fmt/format.h>
+
+#include <climits>
+#include <iostream>
+#include <memory>
+
+#include "OptionRange.h"
+#include "OutputSet.h"
+#include "cli/DeviceArgs.h"
+#include "cli/EnvmapInputs.h"
+#include "cli/SceneArgs.h"
+#include "cli/Subcommand.h"
+#include "render/Reference.h"
+#include "scene/ExrIO.h"
+
+namespace misalloc {
+namespace {
+
+struct ReferenceArgs {
+  SceneArgs scene;
+  DeviceArgs devices;
+  int spp = 16384;
+  std::string cacheDir = defaultCacheDir(), out;
+};
+
+int runReference(ReferenceArgs& args) {
+  OutputSet outputs(envmapInputs({args.scene.parsed()}));
+  if (!args.out.empty()) outputs.claim("--out", args.out);
+  Scene scene = args.scene.make();
+  auto sampler = args.devices.makeSampler(scene, SamplerConfig{}, kDefaultLocalSize);
+  auto reference = findReference(*sampler, scene, args.spp, args.cacheDir, true);
+  if (!args.out.empty()) outputs.put(args.out, encodeExr(reference->image));
+  outputs.commit();
+  std::cout << fmt::format("reference: {}{}\n", reference->source,
+                           reference->path.empty() ? "" : " at " + reference->path);
+  return 0;
+}
+
+}  // namespace
+
+Subcommand addReferenceCommand(CLI::App& app) {
+  auto* command = app.add_subcommand("reference", "compute (or find in the cache) a converged reference image");
+  auto args = std::make_shared<ReferenceArgs>();
+  args->scene.add(*command);
+  command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
+  args->devices.add(*command, "comma-separated: auto, cpu, gpu, index, host, all or D:N");
+  command->add_option("--cache-dir", args->cacheDir, "where references are cached")->capture_default_str();
+  command->add_option("--out", args->out, "also write the reference to this EXR");
+  return {command, [args] { return runReference(*args); }};
+}
+
+}  // namespace misalloc

@@ -1,0 +1,148 @@
+// misalloc render: one scene with one method, its image, report and α map, and its
+// error against a reference.
+#include <fmt/format.h>
+
+#include <climits>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "Error.h"
+#include "JsonText.h"
+#include "OptionRange.h"
+#include "OutputSet.h"
+#include "cli/AdaptiveArgs.h"
+#include "cli/DeviceArgs.h"
+#include "cli/EnvmapInputs.h"
+#include "cli/SceneArgs.h"
+#include "cli/StatisticsMemory.h"
+#include "cli/Subcommand.h"
+#include "render/AlphaMap.h"
+#include "render/BrdfCoverage.h"
+#include "render/Costs.h"
+#include "render/ImageMetrics.h"
+#include "render/Method.h"
+#include "render/Reference.h"
+#include "render/Render.h"
+#include "render/Report.h"
+#include "scene/ExrIO.h"
+
+namespace misalloc {
+namespace {
+
+struct RenderArgs {
+  SceneArgs scene;
+  AdaptiveArgs adaptive;
+  DeviceArgs devices;
+  int spp = 200, localSize = kDefaultLocalSize, referenceSpp = 16384;
+  uint64_t seed = 1;
+  std::string method = "exact", estimator = "multi", out = "render.exr", report = "render.json", reference = "auto",
+              cacheDir = defaultCacheDir(), alphaMap;
+};
+
+Estimator parseEstimator(const std::string& name) {
+  if (name == "multi") return Estimator::MultiSample;
+  if (name == "one") return Estimator::OneSample;
+  throw InputError(fmt::format("--estimator '{}': expected multi or one", name));
+}
+
+int runRender(RenderArgs& args) {
+  const Method m = parseMethod(args.method);
+  const MethodTraits& traits = methodTraits(m);
+  const Estimator estimator = parseEstimator(args.estimator);
+  if (traits.adaptive() && estimator != Estimator::MultiSample)
+    throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", args.estimator));
+  std::vector<NamedFile> inputs = envmapInputs({args.scene.parsed()});
+  if (args.reference != "auto" && args.reference != "none") inputs.push_back({"--reference", args.reference});
+  OutputSet outputs(inputs);
+  outputs.claim("--out", args.out);
+  outputs.claim("--report", args.report);
+  if (!args.alphaMap.empty()) {
+    outputs.claim("--alpha-map", args.alphaMap);
+    outputs.claim("--alpha-map", alphaPngPath(args.alphaMap));
+  }
+  Scene scene = args.scene.make();
+  AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
+  requireBrdfCoverage(scene.options.envmapPdf, scene.techniqueCount(), m, estimator, args.spp, adaptive);
+  std::string costSource = adaptive.costs.empty() ? "measured" : "--cost";
+  if (traits.split == Split::Staged)
+    stageSizes(adaptive.pilotFraction, adaptive.stages, args.spp, scene.techniqueCount());
+  if (traits.split == Split::Probed && adaptive.oracleSamples < 2 * scene.techniqueCount())
+    throw InputError(
+        fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
+  SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
+  requireStatisticsMemory(scene.options, m, "--spp", args.spp, adaptive, args.devices.onHost());
+  auto sampler = args.devices.makeSampler(scene, config, args.localSize);
+  std::string deviceName = args.devices.name();
+  // Without statistics: for the reference and for measuring costs.
+  std::unique_ptr<StageSampler> plain;
+  const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
+  auto plainSampler = [&]() -> StageSampler& {
+    if (!plain) plain = args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize);
+    return *plain;
+  };
+  std::optional<Reference> reference;
+  if (args.reference == "auto")
+    reference = findReference(plainSampler(), plainScene, args.referenceSpp, args.cacheDir, true);
+  else if (args.reference != "none")
+    reference = Reference{readExr(args.reference), "file", args.reference};
+  if (reference) checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
+  if (traits.adaptive() && adaptive.costs.empty()) adaptive.costs = measureCosts(plainSampler());
+  Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);
+  nlohmann::json report =
+      renderReport({scene, m, config.estimator, adaptive, costSource, args.spp, args.seed, deviceName, r, reference});
+  outputs.put(args.out, encodeExr(r.image));
+  if (!args.alphaMap.empty()) {
+    AlphaMapFiles alpha = encodeAlphaMaps(scene, r);
+    outputs.put(args.alphaMap, std::move(alpha.exr));
+    outputs.put(alphaPngPath(args.alphaMap), std::move(alpha.png));
+  }
+  outputs.put(args.report, jsonText(report));
+  outputs.commit();
+  std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s, allocation {:.3f} s)\n",
+                           deviceName, scene.options.envmap, scene.options.grid, scene.grid.width, scene.grid.height,
+                           args.spp, traits.name, r.wallSeconds, r.kernelSeconds, r.allocationSeconds);
+  if (reference)
+    std::cout << fmt::format("RMSE x1000 {:.3f}, relative MSE {:.4g} (reference: {})\n",
+                             report["rmse_x1000"].get<double>(), report["relative_mse"].get<double>(),
+                             reference->source);
+  std::cout << fmt::format(
+      "wrote {} and {}{}\n", args.out, args.report,
+      args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
+  return 0;
+}
+
+}  // namespace
+
+Subcommand addRenderCommand(CLI::App& app) {
+  auto* command = app.add_subcommand("render", "render a scene (default: forest_slope x seed000, 128x128, 200 spp)");
+  auto args = std::make_shared<RenderArgs>();
+  args->scene.add(*command);
+  args->scene.addEnvmapPdf(*command);
+  command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
+  command->add_option("--method", args->method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
+      ->capture_default_str();
+  args->adaptive.add(*command);
+  command->add_option("--alpha-map", args->alphaMap,
+                      "write the per-pixel allocation: EXR here, false-colour PNG beside");
+  command->add_option("--estimator", args->estimator, "fixed splits: multi ([HS14] eq. 4.1) or one (one-sample MIS)")
+      ->capture_default_str();
+  command->add_option("--seed", args->seed, "random seed")->capture_default_str()->check(anyUnsigned64());
+  args->devices.add(*command,
+                    "comma-separated: auto, cpu, gpu, an index from `misalloc devices`, host (C++), all, or D:N "
+                    "(device D in N sub-devices)");
+  command->add_option("--out", args->out, "output EXR")->capture_default_str();
+  command->add_option("--report", args->report, "output JSON report")->capture_default_str();
+  command
+      ->add_option("--reference", args->reference,
+                   "auto (analytic, cached, or computed and cached), none, or an EXR path")
+      ->capture_default_str();
+  command->add_option("--reference-spp", args->referenceSpp, "spp of a sampled reference")
+      ->capture_default_str()
+      ->check(integerIn(1, INT_MAX));
+  command->add_option("--cache-dir", args->cacheDir, "where references are cached")->capture_default_str();
+  command->add_option("--local-size", args->localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
+  return {command, [args] { return runRender(*args); }};
+}
+
+}  // namespace misalloc

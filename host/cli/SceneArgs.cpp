@@ -1,0 +1,73 @@
+#include "cli/SceneArgs.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <vector>
+
+#include "Error.h"
+#include "MemoryBudget.h"
+#include "NumberList.h"
+#include "OptionRange.h"
+
+namespace misalloc {
+
+void SceneArgs::add(CLI::App& command) {
+  command
+      .add_option("--envmap", options.envmap,
+                  "EXR path, shipped map name (forest_slope, rooitou_park, ...), constant[:R], cosk:K or "
+                  "sun[:THETA,PHI,RADIUS,RATIO]")
+      ->capture_default_str();
+  command.add_option("--grid", options.grid, "seed000, general:RD0,RD1,N0,N1 or uniform:RD,RS,N")
+      ->capture_default_str();
+  command.add_option("--size", size, "WxH pixels")->capture_default_str();
+  command.add_option("--view", view, "view direction: polar angle THETA[,PHI] in degrees")->capture_default_str();
+  command.add_flag("--split-brdf", options.splitBrdf,
+                   "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
+  command.add_option("--envmap-sampler", sampler, "alias (O(1)) or cdf (two binary searches)")->capture_default_str();
+  command.add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
+      ->capture_default_str()
+      ->check(integerIn(2, 16384));
+}
+
+void SceneArgs::addEnvmapPdf(CLI::App& command) {
+  command
+      .add_option("--envmap-pdf", envmapPdf,
+                  "plain (∝ luminance) or compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C "
+                  "default 0.5)")
+      ->capture_default_str();
+}
+
+SceneOptions SceneArgs::parsed() {
+  std::tie(options.width, options.height) = parseImageSize(size);
+  const double pixels = double(options.width) * options.height;
+  requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
+                    pixels * kRenderBytesPerPixel);
+  std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");
+  if (angles.size() > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
+  options.viewTheta = angles[0];
+  options.viewPhi = angles.size() > 1 ? angles[1] : 0;
+  options.sampler = parseEnvmapSampler(sampler);
+  options.envmapPdf = parseEnvmapPdf(envmapPdf);
+  return options;
+}
+
+Scene SceneArgs::make() {
+  parsed();
+  Scene scene = makeScene(options);
+  const ReadWarnings& repaired = scene.envmapWarnings;
+  if (repaired.negativeValues > 0)
+    std::cerr << fmt::format("misalloc: warning: {}: {} negative values set to 0 (first at {})\n", scene.envmapPath,
+                             repaired.negativeValues, toString(repaired.firstNegative));
+  if (scene.tables.uniformFallback)
+    std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: its sampling falls back to uniform\n",
+                             options.envmap);
+  if (scene.tables.requestedPdf.compensated() && !scene.tables.pdf.compensated())
+    std::cerr << fmt::format(
+        "misalloc: warning: envmap '{}': no texel exceeds 2(1-C) times the mean luminance; "
+        "--envmap-pdf {} falls back to plain\n",
+        options.envmap, envmapPdfName(scene.tables.requestedPdf));
+  return scene;
+}
+
+}  // namespace misalloc
