@@ -121,10 +121,15 @@ std::vector<Device> openSubDevices(const std::string& spec, int count) {
   const cl_device_partition_property equally[] = {CL_DEVICE_PARTITION_EQUALLY, cl_device_partition_property(units), 0};
   std::vector<cl::Device> parts;
   whole.device.createSubDevices(equally, &parts);
+  parts.resize(size_t(count));
+  // One context: buffers made in it serve every part (render/Sampler.h, SceneBuffers).
+  const cl::Context shared(parts);
   std::vector<Device> devices;
   for (int i = 0; i < count; ++i) {
-    devices.push_back(withQueue(whole.platform, parts.at(size_t(i))));
-    devices.back().part = fmt::format("sub-device {}/{}", i + 1, count);
+    Device part{whole.platform, parts[size_t(i)], shared,
+                cl::CommandQueue(shared, parts[size_t(i)], CL_QUEUE_PROFILING_ENABLE),
+                fmt::format("sub-device {}/{}", i + 1, count)};
+    devices.push_back(std::move(part));
   }
   return devices;
 }

@@ -31,8 +31,8 @@ Device openDevice(const std::string& spec);
 std::vector<Device> openAllDevices();
 
 // The device `spec` names (as openDevice) partitioned into `count` sub-devices of equal
-// compute units (clCreateSubDevices, CL_DEVICE_PARTITION_EQUALLY), each with its own
-// context and queue (`--device cpu:N`). Throws InputError where the device cannot.
+// compute units (clCreateSubDevices, CL_DEVICE_PARTITION_EQUALLY), in one context,
+// each with its own queue (`--device cpu:N`). Throws InputError where the device cannot.
 std::vector<Device> openSubDevices(const std::string& spec, int count);
 
 // The device time between a command's start and end (profiling events).

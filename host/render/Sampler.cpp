@@ -125,7 +125,19 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       localSize);
 }
 
-Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize)
+SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
+  const EnvmapTables& t = scene.tables;
+  texels = upload(device, t.texels);
+  cdfTable = upload(device, t.cdfTable);
+  aliasTable = upload(device, t.aliasTable);
+  std::vector<float> params;
+  params.reserve(scene.grid.pixels.size() * 4);
+  for (const auto& p : scene.grid.pixels) params.insert(params.end(), {p.rhoD, p.rhoS, p.n, 0.0f});
+  brdfParams = upload(device, params);
+}
+
+Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize,
+                 std::shared_ptr<const SceneBuffers> sceneBuffers)
     : StageSampler(scene, config), device_(device) {
   if (localSize < 0) throw InputError("--local-size must be at least 1, or 0 to choose per device");
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
@@ -141,14 +153,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
                      ? cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, plainConfig(config), localSize_)),
                                   "sampleStage")
                      : kernel_;
-  const EnvmapTables& t = scene.tables;
-  texels_ = upload(device, t.texels);
-  cdfTable_ = upload(device, t.cdfTable);
-  aliasTable_ = upload(device, t.aliasTable);
-  std::vector<float> params;
-  params.reserve(scene.grid.pixels.size() * 4);
-  for (const auto& p : scene.grid.pixels) params.insert(params.end(), {p.rhoD, p.rhoS, p.n, 0.0f});
-  brdfParams_ = upload(device, params);
+  if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
+  if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
+  sceneBuffers_ = std::move(sceneBuffers);
   // OpenCL buffers cannot be empty: a method without running sums or stored samples
   // gets a one-element placeholder.
   const size_t accSize = doubleSums_ ? sizeof(double) : sizeof(float);
@@ -217,8 +224,9 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   const std::vector<int32_t> order = coherentPixelOrder(plan, range);
   queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
-  bindKernelArgs(kernel, texels_, cdfTable_, aliasTable_, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
-                 brdfParams_, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
+  const SceneBuffers& b = *sceneBuffers_;
+  bindKernelArgs(kernel, b.texels, b.cdfTable, b.aliasTable, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
+                 b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
                  cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(range.size()),
                  pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;

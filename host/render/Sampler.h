@@ -83,12 +83,29 @@ SamplerConfig plainConfig(SamplerConfig config);
 // statistics and work-group size.
 std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize);
 
+// A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
+// that share a context (the sub-devices of one device, cl/Device.h) share one copy, so
+// that their caches hold one set of tables.
+class SceneBuffers {
+ public:
+  SceneBuffers(const Device& device, const Scene& scene);
+  cl_context context() const { return context_; }
+
+  cl::Buffer texels, cdfTable, aliasTable, brdfParams;
+
+ private:
+  cl_context context_;
+};
+
 // Runs kernels/sample.cl (sampleStage) on a device. The program is built and the
 // scene uploaded once; each run() takes one stage for every pixel.
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
-  Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0);
+  // `sceneBuffers`: made for this device's context, shared with other samplers; null:
+  // its own.
+  Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
+          std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
   int localSize() const { return localSize_; }
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
@@ -108,7 +125,8 @@ class Sampler : public StageSampler {
   int localSize_;
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
-  cl::Buffer texels_, cdfTable_, aliasTable_, brdfParams_, stats_, samples_;
+  std::shared_ptr<const SceneBuffers> sceneBuffers_;
+  cl::Buffer stats_, samples_;
   // A stage's per-pixel inputs and outputs, whole-image sized so that a tile writes its rows.
   cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
   DeviceShare share_;  // since reset()

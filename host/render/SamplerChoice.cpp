@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <map>
 
 #include "Error.h"
 #include "render/TiledSampler.h"
@@ -90,13 +91,17 @@ std::pair<std::string, int> subDeviceEntry(const std::string& entry) {
   return {entry.substr(0, colon), count};
 }
 
+// `shared`: the scene buffers made so far, one per context, for devices that share one.
 std::unique_ptr<StageSampler> makeDeviceSampler(const Device* device, const Scene& scene, const SamplerConfig& config,
-                                                int localSize) {
+                                                int localSize,
+                                                std::map<cl_context, std::shared_ptr<const SceneBuffers>>& shared) {
   if (!device) return std::make_unique<HostSampler>(scene, config);
   requireTablesFit(*device, scene);
   try {
-    // The constructor allocates every buffer and launches the kernel once.
-    return std::make_unique<Sampler>(*device, scene, config, localSize);
+    std::shared_ptr<const SceneBuffers>& buffers = shared[device->context()];
+    if (!buffers) buffers = std::make_shared<SceneBuffers>(*device, scene);
+    // The constructor allocates every other buffer and launches the kernel once.
+    return std::make_unique<Sampler>(*device, scene, config, localSize, buffers);
   } catch (const cl::Error& e) {
     throw explain(e, *device, scene, config, localSize);
   }
@@ -129,9 +134,11 @@ void SamplerDevices::open() {
 std::unique_ptr<StageSampler> SamplerDevices::makeSampler(const Scene& scene, const SamplerConfig& config,
                                                           int localSize) {
   open();
-  if (devices_.size() == 1) return makeDeviceSampler(devices_[0].get(), scene, config, localSize);
+  std::map<cl_context, std::shared_ptr<const SceneBuffers>> shared;
+  if (devices_.size() == 1) return makeDeviceSampler(devices_[0].get(), scene, config, localSize, shared);
   std::vector<std::unique_ptr<StageSampler>> members;
-  for (const auto& device : devices_) members.push_back(makeDeviceSampler(device.get(), scene, config, localSize));
+  for (const auto& device : devices_)
+    members.push_back(makeDeviceSampler(device.get(), scene, config, localSize, shared));
   return std::make_unique<TiledSampler>(scene, config, std::move(members));
 }
 
