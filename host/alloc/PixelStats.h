@@ -1,10 +1,12 @@
 #pragma once
 // Running per-pixel sums from which the allocation rules estimate their statistics.
+#include "KernelCode.h"
 
 namespace misalloc {
 
-// The largest M any rule supports: [SS23]'s Example 5 combines four techniques.
-inline constexpr int kMaxTechniques = 4;
+// The largest M any rule supports, the grid search's (kernels/common.h): [SS23]'s
+// Example 5 combines four techniques.
+inline constexpr int kMaxTechniques = MA_GRID_MAX_TECHNIQUES;
 
 // Sums over the samples X_kj drawn from one technique k. Every field is a double so
 // the struct is a flat block of doubles that a kernel can accumulate in place.
