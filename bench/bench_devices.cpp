@@ -1,4 +1,4 @@
-// One render split across devices (render/TiledSampler.h) against each device alone:
+// One render split across devices (sampling/TiledSampler.h) against each device alone:
 // PoCL's CPU device in two 1-core sub-devices (`--device cpu:2`) against one of them and
 // against the whole device, and, where a GPU is present, `gpu,cpu` against the sum of
 // their rates alone. Interleaved repeats, medians, ratios from one run.
@@ -16,10 +16,10 @@
 #include <map>
 
 #include "cl/Device.h"
-#include "render/Costs.h"
 #include "render/Render.h"
-#include "render/SamplerChoice.h"
-#include "render/Scene.h"
+#include "sampling/Costs.h"
+#include "sampling/SamplerChoice.h"
+#include "scene/Scene.h"
 
 using namespace misalloc;
 

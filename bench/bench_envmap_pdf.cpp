@@ -14,8 +14,8 @@
 
 #include "cl/Device.h"
 #include "render/Render.h"
-#include "render/Sampler.h"
-#include "render/Scene.h"
+#include "sampling/Sampler.h"
+#include "scene/Scene.h"
 
 using namespace misalloc;
 

@@ -22,8 +22,9 @@
 #include "PeerComparison.h"
 #include "cl/Device.h"
 #include "render/Render.h"
-#include "render/Sampler.h"
-#include "render/Scene.h"
+#include "sampling/HostSampler.h"
+#include "sampling/Sampler.h"
+#include "scene/Scene.h"
 
 using namespace misalloc;
 

@@ -62,7 +62,7 @@ MA_FN ma_uint ma_as_uint(float f) {
 // draws from at most 3: the envmap and the BRDF, or the envmap and the BRDF's two lobes
 // (--split-brdf); its per-sample arrays have this size. The statistics and the grid
 // search take up to 4 (the papers' 1D examples have up to 4 techniques); host code
-// calls that kMaxTechniques (host/alloc/PixelStats.h).
+// calls that kMaxTechniques (host/stats/PixelStats.h).
 #define MA_MAX_TECHNIQUES 3
 #define MA_GRID_MAX_TECHNIQUES 4
 #if MA_MAX_TECHNIQUES > MA_GRID_MAX_TECHNIQUES

@@ -1,7 +1,7 @@
 // Techniques of the envmap × BRDF estimator and one sample of the balance-heuristic
-// MIS estimator ([HS14] eq. 4.1–4.3). Host side: host/render/Scene.h (techniqueCount,
-// techniqueNames: the techniques in this order), host/render/Sampler.h (the driver of
-// kernels/sample.cl) and host/render/HostSampler.cpp (its C++ reference).
+// MIS estimator ([HS14] eq. 4.1–4.3). Host side: host/scene/Scene.h (techniqueCount,
+// techniqueNames: the techniques in this order), host/sampling/Sampler.h (the driver of
+// kernels/sample.cl) and host/sampling/HostSampler.cpp (its C++ reference).
 #include "namespace_check.h"
 #ifndef MA_ESTIMATOR_H
 #define MA_ESTIMATOR_H
@@ -25,8 +25,7 @@ typedef struct {
   int texel;  // technique 0: the envmap texel it drew wi in
 } TechniqueSample;
 
-MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique,
-                                      MaRandom4 rnd) {
+MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd) {
   TechniqueSample s;
   s.texel = 0;
   if (technique == MA_TECHNIQUE_ENVMAP) {

@@ -1,5 +1,5 @@
 // [HS14]'s Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
-// kernel (kernels/gridsearch.cl) and its C++ reference (host/alloc/GridSearch.cpp)
+// kernel (kernels/gridsearch.cl) and its C++ reference (host/sampling/GridSearch.cpp)
 // share, so that both compute bit for bit the same sums and rank the weight
 // combinations with the same code. Only the loop over samples × combinations is each
 // side's own: float16 over 16 combinations in the kernel, plain loops in C++.
@@ -16,7 +16,6 @@
 // Which weight combination Algorithm 1 keeps ([HS14] Alg. 1 line 13).
 #define MA_RULE_MAX_ENTROPY 0        // as written: λ_{j,l} closest to uniform by entropy
 #define MA_RULE_MIN_COST_VARIANCE 1  // least cost × variance of the multi-sample estimator
-
 
 // Value q of a pixel's sample i, with `pixelSamples` at the pixel's first value: the
 // layout of kernels/stats.h (storedSampleIndex), records of M + 2 rows of 16 pixels.
@@ -207,14 +206,14 @@ MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount
 // negative V, which is 0.
 // Defined for T = float and, in the kernel, T = float16 (16 combinations at once):
 // OpenCL C has no overloading, and the builtins in the body take either.
-#define MA_DEFINE_COST_VARIANCE_SCORE(name, T)                                                                   \
-  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const T* sumM, T sumS2, float invCount) {        \
-    T muTerm = 0.0f;                                                                                            \
-    for (int j = 0; j < techniqueCount; ++j) {                                                                  \
-      T mu = sumM[j] * invCount;                                                                                \
-      muTerm = ma_fma(alpha[j] * mu, mu, muTerm);                                                               \
-    }                                                                                                           \
-    return -(meanCost * ma_max(ma_fma(sumS2, (T)invCount, -muTerm), 0.0f));                                     \
+#define MA_DEFINE_COST_VARIANCE_SCORE(name, T)                                                           \
+  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const T* sumM, T sumS2, float invCount) { \
+    T muTerm = 0.0f;                                                                                     \
+    for (int j = 0; j < techniqueCount; ++j) {                                                           \
+      T mu = sumM[j] * invCount;                                                                         \
+      muTerm = ma_fma(alpha[j] * mu, mu, muTerm);                                                        \
+    }                                                                                                    \
+    return -(meanCost * ma_max(ma_fma(sumS2, (T)invCount, -muTerm), 0.0f));                              \
   }
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore, float)
 #ifdef __OPENCL_VERSION__
@@ -277,7 +276,7 @@ MA_FN float gridScore(int rule, int techniqueCount, const float* alpha, float me
                                      : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2[0], invTotal);
 }
 
-// Pooled selection (host/alloc/Pooling.h says why): a pixel ranks the combinations by
+// Pooled selection (host/stats/Pooling.h says why): a pixel ranks the combinations by
 // the sum of its neighbours' scores, each brought from its own scale to the smallest
 // scale in the window, so that no factor exceeds 1 and the sum cannot overflow.
 MA_FN float poolingFactor(float scaleMin, float scale) {

@@ -1,6 +1,6 @@
 // One pixel's share of a sampling stage: which technique takes sample j, the sample's
 // contribution to the estimate, and the running sums the allocations use. Shared by
-// kernels/sample.cl and its C++ reference (host/render/HostSampler.cpp). Everything is
+// kernels/sample.cl and its C++ reference (host/sampling/HostSampler.cpp). Everything is
 // scalar fields, not arrays: PoCL keeps a kernel scalar that indexes private arrays
 // dynamically.
 #include "namespace_check.h"

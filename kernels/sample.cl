@@ -1,8 +1,8 @@
 // One stage of the multi-sample ([HS14] eq. 4.1) or one-sample balance-heuristic
-// estimator for every pixel at once. Host side: host/render/Sampler.h runs it,
-// host/render/HostSampler.cpp is its C++ reference.
+// estimator for every pixel at once. Host side: host/sampling/Sampler.h runs it,
+// host/sampling/HostSampler.cpp is its C++ reference.
 //
-// Compile-time options (sampleKernelOptions in host/render/Sampler.cpp):
+// Compile-time options (sampleKernelOptions in host/sampling/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
 // MA_COSK (< 0: the texels), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the running
 // sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the

@@ -1,5 +1,5 @@
 // The running per-pixel sums that the allocations estimate their statistics from
-// (host/alloc/PixelStats.h, which decodes them). A stage adds each sample to the sums
+// (host/stats/PixelStats.h, which decodes them). A stage adds each sample to the sums
 // of the technique that drew it; MA_STATS chooses which sums a method keeps, so that
 // each method stores only what it reads.
 #include "namespace_check.h"
@@ -13,8 +13,8 @@
 
 // Per technique: the count, then the sums that `mask` selects, in the order above; no
 // slot at all when the method keeps no sums. A macro: kernels size local arrays with it.
-#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                              \
-  ((mask) == 0 ? 0                                                                                \
+#define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                               \
+  ((mask) == 0 ? 0                                                                                 \
                : 1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
                      (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
 

@@ -7,8 +7,8 @@
 
 #include "Constants.h"
 #include "render/Method.h"
-#include "render/Sampler.h"
-#include "render/Scene.h"
+#include "sampling/Sampler.h"
+#include "scene/Scene.h"
 
 namespace misalloc::test {
 

@@ -13,9 +13,9 @@
 #include "alloc/Apportion.h"
 #include "alloc/HeuristicAllocation.h"
 #include "alloc/LinearAllocation.h"
-#include "alloc/PixelSamples.h"
-#include "alloc/PixelStats.h"
 #include "alloc/SigmaAllocation.h"
+#include "stats/PixelSamples.h"
+#include "stats/PixelStats.h"
 
 using namespace misalloc;
 
@@ -347,4 +347,3 @@ TEST_CASE("apportionCounts sums exactly to N by largest remainder", "[alloc]") {
   CHECK_THROWS_AS(apportionCounts({kNaN, 1.0}, 10), std::invalid_argument);
   CHECK_THROWS_AS(apportionCounts({1.0}, -1), std::invalid_argument);
 }
-

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
-#include "RunRecords.h"
 #include "Error.h"
+#include "RunRecords.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 #include "TestSize.h"
@@ -20,7 +20,7 @@
 #include "render/BrdfCoverage.h"
 #include "render/Reference.h"
 #include "render/Render.h"
-#include "render/Report.h"
+#include "report/Report.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -219,7 +219,7 @@ TEST_CASE("compare runs each scene with each envmap pdf and compares them with e
     c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
     for (int budget : {10, 20})
       c.runs.push_back(record(label, Method::Equal, budget, 0, 0.01 * budget,
-                                 (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));
+                              (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));
   }
   CompareOptions o;
   o.methods = {Method::Equal};

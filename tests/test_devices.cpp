@@ -1,4 +1,4 @@
-// One render over several devices (render/TiledSampler.h): the same image, bit for bit,
+// One render over several devices (sampling/TiledSampler.h): the same image, bit for bit,
 // as on one device of the same arithmetic, every pixel exactly once; a device that fails
 // has its tiles run again on the others, and with none left the render stops.
 #include <fmt/format.h>
@@ -13,8 +13,9 @@
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 #include "render/Render.h"
-#include "render/SamplerChoice.h"
-#include "render/TiledSampler.h"
+#include "sampling/HostSampler.h"
+#include "sampling/SamplerChoice.h"
+#include "sampling/TiledSampler.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -138,16 +139,17 @@ TEST_CASE("with every device failed the render stops with a DeviceError", "[devi
   AdaptiveOptions options = fixedCosts(scene);
   const SamplerConfig config = samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options);
   auto tiled = withFailingMember(scene, config, {1, 1});
-  CHECK_THROWS_WITH(render(*tiled, Method::Equal, options, 16, 5), Catch::Contains("every device failed") &&
-                                                                       Catch::Contains("injected failure"));
+  CHECK_THROWS_WITH(render(*tiled, Method::Equal, options, 16, 5),
+                    Catch::Contains("every device failed") && Catch::Contains("injected failure"));
 }
 
 TEST_CASE("render over a device list reports each device's share and the imbalance", "[devices][cli]") {
   TempDir dir("devices");
   auto out = dir.path / "r.exr", report = dir.path / "r.json";
-  auto r = runMisalloc(fmt::format("render --envmap cosk:1 --size 48x32 --spp 16 --method equal --device {} "
-                                   "--out {} --report {} --reference none",
-                                   twoCpuDevices(), out.string(), report.string()));
+  auto r =
+      runMisalloc(fmt::format("render --envmap cosk:1 --size 48x32 --spp 16 --method equal --device {} "
+                              "--out {} --report {} --reference none",
+                              twoCpuDevices(), out.string(), report.string()));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
@@ -163,8 +165,8 @@ TEST_CASE("device lists that name nothing are refused", "[devices][cli][bad-inpu
   TempDir dir("devices-bad");
   auto out = dir.path / "r.exr";
   for (const char* list : {"cpu,", "cpu:0", "cpu:x", "cpu:1000", "nonsense"}) {
-    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 --method equal --device {} --out {} --reference none", list,
-                                     out.string()));
+    auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 --method equal --device {} --out {} --reference none",
+                                     list, out.string()));
     INFO(list << ": " << r.output);
     CHECK(r.exitCode == 2);
     CHECK(r.output.find("--device") != std::string::npos);

@@ -17,7 +17,7 @@
 #include "Error.h"
 #include "KernelCode.h"
 #include "Statistics.h"
-#include "render/KernelViews.h"
+#include "sampling/KernelViews.h"
 #include "scene/AliasTable.h"
 #include "scene/Envmap.h"
 #include "scene/EnvmapDistribution.h"

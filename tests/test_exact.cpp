@@ -14,10 +14,10 @@
 
 #include "KernelCode.h"
 #include "TestDevice.h"
-#include "alloc/GridSearch.h"
 #include "paper/MixtureVariance.h"
 #include "paper/PaperExamples.h"
 #include "paper/Quadrature.h"
+#include "sampling/GridSearch.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -191,9 +191,9 @@ TEST_CASE("the default grid's best variance is within a few percent of a 160-poi
     WeightGrid grid = makeWeightGrid(m, gridSize, std::vector<double>(m, 1.0));
     double best = std::numeric_limits<double>::infinity();
     for (int l = 0; l < grid.size(); ++l)
-      best = std::min(best, misalloc::multiSampleVariance(
-                                example, std::vector<double>(&grid.alpha[l * m], &grid.alpha[l * m] + m))
-                                .value);
+      best = std::min(
+          best, misalloc::multiSampleVariance(example, std::vector<double>(&grid.alpha[l * m], &grid.alpha[l * m] + m))
+                    .value);
     return best;
   };
   for (const char* id : {"002-1", "002-2", "003-1", "003-3", "003-4", "003-6"}) {
@@ -352,8 +352,8 @@ TEST_CASE("searching stage by stage selects what one search over all the samples
     for (PixelSampleList& pixel : pixels)
       for (Sample& s : pixel) s.technique = int(&s - pixel.data()) % m;
     for (Sample& s : pixels[0]) s.technique = &s - pixels[0].data() < stage ? 0 : s.technique;  // too few, then enough
-    for (Sample& s : pixels[1]) s.f = &s - pixels[1].data() < 40 ? 0.0f : s.f;               // no signal, then signal
-    pixels[2][50].f = std::numeric_limits<float>::quiet_NaN();  // non-finite from stage 2 on
+    for (Sample& s : pixels[1]) s.f = &s - pixels[1].data() < 40 ? 0.0f : s.f;  // no signal, then signal
+    pixels[2][50].f = std::numeric_limits<float>::quiet_NaN();                  // non-finite from stage 2 on
     for (Sample& s : pixels[3])  // a sample in the last stage that dwarfs the ones before
       if (&s - pixels[3].data() >= 80 && s.f > 0.0f) {
         s.f *= 1e12f;

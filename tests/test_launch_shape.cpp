@@ -9,6 +9,7 @@
 #include "TestDevice.h"
 #include "cl/LaunchShape.h"
 #include "render/Render.h"
+#include "sampling/HostSampler.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -62,8 +63,9 @@ TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums,
 TEST_CASE("launch shape: a GPU's work-group limit and lockstep width bound the size", "[launch]") {
   LaunchShape capped = chooseLocalSize(gpu(64), sampleBytes(0));
   CHECK(capped.localSize == 64);
-  CHECK(capped.why == "GPU: 64 work-items, 4.8 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
-                      "per group");
+  CHECK(capped.why ==
+        "GPU: 64 work-items, 4.8 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
+        "per group");
   // A wavefront of 64 skips 32; below every preferred size the largest that fits runs.
   CHECK(chooseLocalSize(gpu(1024, k48KiB, 64), sampleBytes(0)).localSize == 256);
   CHECK(chooseLocalSize(gpu(1024, 4096, 64), sampleBytes(0)).localSize == 32);

@@ -8,6 +8,7 @@
 #include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "sampling/HostSampler.h"
 
 using namespace misalloc;
 using namespace misalloc::test;

@@ -24,19 +24,18 @@
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 #include "TestSize.h"
-#include "alloc/PixelStats.h"
 #include "paper/MixtureOptimizer.h"
 #include "paper/MonteCarloStudy.h"
 #include "paper/PaperExamples.h"
-#include "render/ImageMetrics.h"
 #include "render/Render.h"
+#include "report/ImageMetrics.h"
 #include "scene/ExrIO.h"
+#include "stats/PixelStats.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
 
 namespace {
-
 
 const std::vector<Method> kAdaptive = {Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact};
 
@@ -223,16 +222,17 @@ TEST_CASE("lobes partly below the horizon: techniques agree, split or not", "[st
   uint64_t seed = 3000;
   for (bool split : {false, true}) {
     Scene scene = smallScene("constant", "uniform:0.1,0.9,5", 32, 32, split, EnvmapSampler::Cdf, 70.0);
-    checkMethods(scene, {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC},
-                 64, seed += 10, NAN, fmt::format("view 70 split {}", split));
+    checkMethods(scene, {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC}, 64,
+                 seed += 10, NAN, fmt::format("view 70 split {}", split));
   }
 }
 
 TEST_CASE("pure diffuse rhoD = 1: closed form, and BRDF sampling of a constant map is exact", "[stability]") {
   uint64_t seed = 4000;
   Scene cosk = smallScene("cosk:2", "uniform:1,0,1", 16, 16);
-  checkMethods(cosk, {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC,
-                      Method::Linear, Method::Exact},
+  checkMethods(cosk,
+               {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC, Method::Linear,
+                Method::Exact},
                32, seed, closedForm(1, 0, 1, 2), "cosk:2");
   // f/p = L ρd = 1 for every BRDF sample: every pixel is 1 up to float rounding.
   Scene constant = smallScene("constant", "uniform:1,0,1", 16, 16);
@@ -253,8 +253,8 @@ TEST_CASE("rooitou_park, 69 % of the power in 0.1 % of the texels: techniques ag
   // adaptive methods must not fall into that: the defensive floor keeps every
   // technique at one sample per stage (flooredPixels).
   Scene scene = smallScene("rooitou_park", "uniform:0.5,0.5,50", 32, 32);
-  checkMethods(scene, {Method::Envmap, Method::Equal, Method::Heuristic, Method::SigmaSqrtC,
-                       Method::Linear, Method::Exact},
+  checkMethods(scene,
+               {Method::Envmap, Method::Equal, Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact},
                64, 5000, NAN, "rooitou_park", {}, {Method::Envmap, Method::Equal, Method::Exact});
 }
 
@@ -271,13 +271,13 @@ TEST_CASE("an all-black map gives exact zeros, the uniform fallback and no-signa
   for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
     Scene scene = smallScene("constant:0", "uniform:0.5,0.5,20", 16, 16, true, s);
     CHECK(scene.tables.uniformFallback);
-    for (Method m : {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC,
-                     Method::Linear, Method::Exact, Method::Oracle}) {
+    for (Method m : {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC, Method::Linear,
+                     Method::Exact, Method::Oracle}) {
       Rendering r = renderWith(scene, m, 30, 6000);
       INFO(methodName(m));
       CHECK(badValues(r, 3) == 0);
       CHECK(std::all_of(r.image.rgb.begin(), r.image.rgb.end(), [](float v) { return v == 0.0f; }));
-      if (isAdaptive(m) && m != Method::Oracle) CHECK(r.fallbackPixels == size_t(scene.pixelCount()));
+      if (methodTraits(m).split == Split::Staged) CHECK(r.fallbackPixels == size_t(scene.pixelCount()));
     }
   }
 }
@@ -292,8 +292,7 @@ TEST_CASE("a single bright texel: unbiased against its closed form", "[stability
   std::string path = writeMap("single-texel", W, H, rgb);
   const double pi = kPi;
   const double t0 = pi * row / H, t1 = pi * (row + 1) / H;
-  const double expected =
-      L / pi * (2 * pi / W) * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0)) / 2;
+  const double expected = L / pi * (2 * pi / W) * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0)) / 2;
   for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
     Scene scene = smallScene(path, "uniform:1,0,1", 32, 32, false, s);
     CHECK_FALSE(scene.tables.uniformFallback);
@@ -313,8 +312,8 @@ TEST_CASE("a map black on the upper hemisphere: the true value 0 is estimated as
   RgbImage zero;
   zero.width = zero.height = 16;
   zero.rgb.assign(size_t(3) * 16 * 16, 0.0f);
-  for (Method m : {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC,
-                   Method::Linear, Method::Exact}) {
+  for (Method m : {Method::Equal, Method::Envmap, Method::Brdf, Method::Heuristic, Method::SigmaSqrtC, Method::Linear,
+                   Method::Exact}) {
     Rendering r = renderWith(scene, m, 30, 8000);
     INFO(methodName(m));
     CHECK(badValues(r, 2) == 0);
@@ -398,8 +397,8 @@ TEST_CASE("a 16384x8192 map: tables sum to 1 in double and sampling stays unbias
 
 TEST_CASE("[SS23] example 6: the optimum on the simplex boundary, alpha_1 = 0", "[stability]") {
   Example1D example = paperExample("003-6");
-  OptimalMixture best = minimiseInefficiency(example, VarianceModel::MultiSample,
-                                             std::vector<double>(example.costs().size(), 1.0));
+  OptimalMixture best =
+      minimiseInefficiency(example, VarianceModel::MultiSample, std::vector<double>(example.costs().size(), 1.0));
   INFO(fmt::format("alpha {}", fmt::join(best.alpha, ", ")));
   CHECK(onSimplex(best.alpha));
   CHECK(best.alpha[0] < 1e-6);
@@ -447,8 +446,7 @@ TEST_CASE("a pilot of 2 samples per technique whose values are all equal", "[sta
     Rendering r = renderWith(scene, m, 20, 10000);
     MeanAndError e = imageMean(r);
     double z = zScore(e.mean, 1.0, e.standardError);
-    INFO(fmt::format("{}: mean {} ± {} z {} fallback {}", methodName(m), e.mean, e.standardError, z,
-                     r.fallbackPixels));
+    INFO(fmt::format("{}: mean {} ± {} z {} fallback {}", methodName(m), e.mean, e.standardError, z, r.fallbackPixels));
     CHECK(badValues(r, 2) == 0);
     CHECK(std::abs(z) < kMaxZ);
     if (m == Method::Heuristic) CHECK(r.fallbackPixels == size_t(scene.pixelCount()));  // V_brdf = 0
@@ -471,8 +469,8 @@ TEST_CASE("a technique whose samples are all zero: flagged, weight 0, unbiased",
     Rendering r = renderWith(scene, m, 40, 11000);
     MeanAndError e = imageMean(r);
     double z = zScore(e.mean, expected, e.standardError);
-    INFO(fmt::format("{}: mean {} ± {} expected {} z {} fallback {}", methodName(m), e.mean, e.standardError,
-                     expected, z, r.fallbackPixels));
+    INFO(fmt::format("{}: mean {} ± {} expected {} z {} fallback {}", methodName(m), e.mean, e.standardError, expected,
+                     z, r.fallbackPixels));
     CHECK(badValues(r, 2) == 0);
     CHECK(std::abs(z) < kMaxZ);
     if (m != Method::Exact) {
@@ -571,10 +569,10 @@ TEST_CASE("reports of hard scenes hold only finite numbers and count the defensi
   for (const Case& c : cases) {
     for (const char* method : {"heuristic", "linear"}) {
       fs::path out = dir / "r.exr", report = dir / "r.json";
-      std::string command =
-          fmt::format("{} render {} --size 8x8 --spp 20 --method {} --reference-spp 64 --cache-dir {} --out {} "
-                      "--report {} 2>&1",
-                      MISALLOC_BINARY, c.scene, method, (dir / "cache").string(), out.string(), report.string());
+      std::string command = fmt::format(
+          "{} render {} --size 8x8 --spp 20 --method {} --reference-spp 64 --cache-dir {} --out {} "
+          "--report {} 2>&1",
+          MISALLOC_BINARY, c.scene, method, (dir / "cache").string(), out.string(), report.string());
       FILE* pipe = popen(command.c_str(), "r");
       REQUIRE(pipe != nullptr);
       std::string output;

@@ -1,4 +1,4 @@
-// TileQueue (render/TileQueue.h): every pixel is handed out exactly once, whatever the
+// TileQueue (sampling/TileQueue.h): every pixel is handed out exactly once, whatever the
 // devices' rates, failures and threads, and devices of unequal speed finish together.
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include <queue>
 #include <thread>
 
-#include "render/TileQueue.h"
+#include "sampling/TileQueue.h"
 
 using namespace misalloc;
 

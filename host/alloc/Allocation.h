@@ -5,7 +5,7 @@
 #include <optional>
 #include <vector>
 
-#include "alloc/PixelStats.h"
+#include "stats/PixelStats.h"
 
 namespace misalloc {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "alloc/Allocation.h"
-#include "alloc/PixelSamples.h"
+#include "stats/PixelSamples.h"
 
 namespace misalloc {
 

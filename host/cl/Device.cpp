@@ -122,7 +122,7 @@ std::vector<Device> openSubDevices(const std::string& spec, int count) {
   std::vector<cl::Device> parts;
   whole.device.createSubDevices(equally, &parts);
   parts.resize(size_t(count));
-  // One context: buffers made in it serve every part (render/Sampler.h, SceneBuffers).
+  // One context: buffers made in it serve every part (sampling/Sampler.h, SceneBuffers).
   const cl::Context shared(parts);
   std::vector<Device> devices;
   for (int i = 0; i < count; ++i) {
@@ -146,7 +146,8 @@ cl::Program buildProgram(const Device& device, const std::string& mainFile, cons
 }
 
 double eventSeconds(const cl::Event& event) {
-  return double(event.getProfilingInfo<CL_PROFILING_COMMAND_END>() - event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+  return double(event.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
          1e-9;
 }
 

@@ -6,7 +6,7 @@
 
 #include "Error.h"
 #include "OptionRange.h"
-#include "render/Costs.h"
+#include "sampling/Costs.h"
 
 namespace misalloc {
 namespace {

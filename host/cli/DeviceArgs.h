@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "render/SamplerChoice.h"
+#include "sampling/SamplerChoice.h"
 
 namespace misalloc {
 

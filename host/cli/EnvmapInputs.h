@@ -2,7 +2,7 @@
 #include <vector>
 
 #include "OutputSet.h"
-#include "render/Scene.h"
+#include "scene/Scene.h"
 
 namespace misalloc {
 

@@ -17,14 +17,14 @@
 #include "cli/SceneArgs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
-#include "render/AlphaMap.h"
 #include "render/BrdfCoverage.h"
-#include "render/Costs.h"
-#include "render/ImageMetrics.h"
 #include "render/Method.h"
 #include "render/Reference.h"
 #include "render/Render.h"
-#include "render/Report.h"
+#include "report/AlphaMap.h"
+#include "report/ImageMetrics.h"
+#include "report/Report.h"
+#include "sampling/Costs.h"
 #include "scene/ExrIO.h"
 
 namespace misalloc {

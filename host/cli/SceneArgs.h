@@ -2,7 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "render/Scene.h"
+#include "scene/Scene.h"
 
 namespace misalloc {
 

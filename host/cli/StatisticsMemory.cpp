@@ -23,7 +23,7 @@ void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::str
   if (config.gridSize > 0) {
     // The weight grid, M weights and a cost per combination, is built on the host; the
     // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
-    // (alloc/GridSearch.h). Both from the options alone: building the grid to size it
+    // (sampling/GridSearch.h). Both from the options alone: building the grid to size it
     // would be the allocation this check prevents.
     const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
     const double sumBytes = onHost ? pixels * 2 * M * U * sizeof(float) : 0;

@@ -9,13 +9,13 @@
 #include "Error.h"
 #include "JsonText.h"
 #include "compare/ProgressMeter.h"
-#include "render/AlphaMap.h"
-#include "render/Costs.h"
-#include "render/ImageMetrics.h"
-#include "render/PreviewPng.h"
 #include "render/Reference.h"
-#include "render/Report.h"
-#include "render/SamplerChoice.h"
+#include "report/AlphaMap.h"
+#include "report/ImageMetrics.h"
+#include "report/PreviewPng.h"
+#include "report/Report.h"
+#include "sampling/Costs.h"
+#include "sampling/SamplerChoice.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
@@ -84,10 +84,11 @@ std::string runsCsv(const Comparison& comparison) {
       "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,skipped_pixel_fraction,"
       "statistics_bytes_per_pixel\n";
   for (const RunRecord& r : comparison.runs)
-    csv += fmt::format("{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
-                       r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
-                       r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.mse), r.relativeMse, r.efficiency(),
-                       r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.statisticsBytesPerPixel);
+    csv += fmt::format(
+        "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", r.caseLabel,
+        methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds, r.allocationSeconds,
+        r.hostSeconds, 1000 * std::sqrt(r.mse), r.relativeMse, r.efficiency(), r.meanAlpha.front(), r.fallbackFraction,
+        r.flooredFraction, r.skippedFraction, r.statisticsBytesPerPixel);
   return csv;
 }
 

@@ -7,7 +7,7 @@
 #include "compare/Interruption.h"
 #include "render/Method.h"
 #include "render/Render.h"
-#include "render/Scene.h"
+#include "scene/Scene.h"
 
 namespace misalloc {
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "render/Report.h"
+#include "report/Report.h"
 
 namespace misalloc {
 namespace {

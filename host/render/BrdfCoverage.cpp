@@ -20,7 +20,7 @@ void requireBrdfCoverage(const EnvmapPdf& envmapPdf, int techniqueCount, Method 
         pdf));
   const int M = techniqueCount;
   int smallest = spp;
-  if (isAdaptive(method) && method != Method::Oracle) {
+  if (methodTraits(method).split == Split::Staged) {
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     smallest = *std::min_element(sizes.begin(), sizes.end());
   } else if (!isAdaptive(method) && (method != Method::Equal || estimator == Estimator::OneSample)) {

@@ -3,7 +3,7 @@
 #include <optional>
 #include <string>
 
-#include "render/Sampler.h"
+#include "sampling/Sampler.h"
 #include "scene/ExrIO.h"
 
 namespace misalloc {

@@ -9,9 +9,9 @@
 #include "Error.h"
 #include "alloc/Apportion.h"
 #include "alloc/HeuristicAllocation.h"
-#include "alloc/Pooling.h"
 #include "alloc/SigmaAllocation.h"
-#include "render/RunningStats.h"
+#include "stats/Pooling.h"
+#include "stats/RunningStats.h"
 
 namespace misalloc {
 namespace {
@@ -232,7 +232,8 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
 namespace {
 
 void validateAdaptiveOptions(const AdaptiveOptions& options) {
-  if (options.poolRadius < 0) throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
+  if (options.poolRadius < 0)
+    throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
   if (!(options.minGain >= 0 && options.minGain < 1))
     throw InputError(fmt::format("--skip-below {}: the gain must lie in [0, 1)", options.minGain));
   if (options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)

@@ -2,10 +2,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "alloc/GridSearch.h"
 #include "alloc/LinearAllocation.h"
 #include "render/Method.h"
-#include "render/Sampler.h"
+#include "sampling/GridSearch.h"
+#include "sampling/Sampler.h"
 #include "scene/ExrIO.h"
 
 namespace misalloc {
@@ -14,9 +14,9 @@ namespace misalloc {
 struct AdaptiveOptions {
   double pilotFraction = 0.05;  // of N, split equally among the techniques
   int stages = 1;               // after the pilot
-  int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
-  double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
-  std::vector<double> costs;   // c_k per sample, one per technique
+  int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (stats/Pooling.h)
+  double minGain = 0.02;        // exact: the skip rule's least predicted gain (sampling/GridSearch.h, PooledSelection)
+  std::vector<double> costs;    // c_k per sample, one per technique
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
   GridRule gridRule = GridRule::MinCostVariance;
@@ -36,11 +36,11 @@ struct Rendering {
   size_t skippedPixels = 0;      // pixels that the skip rule kept at equal weights in every stage
   int stageCount = 1;
   double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
-  double kernelSeconds = 0;      // device time of the sampling kernels (profiling events)
-  double allocationSeconds = 0;  // reading statistics back and allocating
-  double hostSeconds = 0;        // everything else: planning, transfers, reductions
+  double kernelSeconds = 0;            // device time of the sampling kernels (profiling events)
+  double allocationSeconds = 0;        // reading statistics back and allocating
+  double hostSeconds = 0;              // everything else: planning, transfers, reductions
   double wallSeconds = 0;
-  std::vector<DeviceShare> devices;  // where it ran (render/TiledSampler.h for several)
+  std::vector<DeviceShare> devices;  // where it ran (sampling/TiledSampler.h for several)
   double imbalanceSeconds = 0;       // several devices: Σ over stages of last finish − first finish
 };
 

@@ -26,11 +26,11 @@
 #include <utility>
 #include <vector>
 
-#include "alloc/GridSearch.h"
 #include "render/Method.h"
 #include "render/Render.h"
-#include "render/Sampler.h"
-#include "render/Scene.h"
+#include "sampling/GridSearch.h"
+#include "sampling/Sampler.h"
+#include "scene/Scene.h"
 
 extern char** environ;
 
@@ -44,9 +44,7 @@ struct Variant {
   std::string file;     // in the kernel folder
   std::string options;  // as the host passes them to clBuildProgram
 
-  bool operator<(const Variant& other) const {
-    return std::tie(file, options) < std::tie(other.file, other.options);
-  }
+  bool operator<(const Variant& other) const { return std::tie(file, options) < std::tie(other.file, other.options); }
 };
 
 Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler) {
@@ -156,9 +154,17 @@ int main(int argc, char** argv) {
   const std::set<Variant> variantSet = hostVariants();
   const std::vector<Variant> variants(variantSet.begin(), variantSet.end());
   auto argsOf = [&](const Variant& v) {
-    std::vector<std::string> args{clang, "-x", "cl", "-cl-std=CL1.2", "-D__OPENCL_VERSION__=120",
-                                  "-target", "nvptx64-nvidia-nvcl", "-Xclang", "-finclude-default-header",
-                                  "-I" + kernelDir, "-I" + random123Dir};
+    std::vector<std::string> args{clang,
+                                  "-x",
+                                  "cl",
+                                  "-cl-std=CL1.2",
+                                  "-D__OPENCL_VERSION__=120",
+                                  "-target",
+                                  "nvptx64-nvidia-nvcl",
+                                  "-Xclang",
+                                  "-finclude-default-header",
+                                  "-I" + kernelDir,
+                                  "-I" + random123Dir};
     for (std::string& w : words(v.options)) args.push_back(std::move(w));
     for (const char* a : {"-S", "-o", "/dev/null"}) args.emplace_back(a);
     args.push_back(kernelDir + "/" + v.file);

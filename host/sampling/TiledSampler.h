@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "render/Sampler.h"
+#include "sampling/Sampler.h"
 
 namespace misalloc {
 
@@ -47,12 +47,12 @@ class TiledSampler : public StageSampler {
   void loadMembers(size_t count);
 
   std::vector<std::unique_ptr<StageSampler>> members_;
-  std::vector<double> sampleRates_;     // samples per second of each member, 0 until measured
-  std::vector<std::string> failures_;   // per member: why it was retired, empty while it runs
-  std::vector<double> stats_;           // every pixel's running sums after the last stage
-  std::vector<float> samples_;          // and its stored samples
-  std::vector<unsigned char> loaded_;   // per member: it holds stats_ and samples_
-  double imbalanceSeconds_ = 0;         // Σ over stages: last finish − first finish
+  std::vector<double> sampleRates_;    // samples per second of each member, 0 until measured
+  std::vector<std::string> failures_;  // per member: why it was retired, empty while it runs
+  std::vector<double> stats_;          // every pixel's running sums after the last stage
+  std::vector<float> samples_;         // and its stored samples
+  std::vector<unsigned char> loaded_;  // per member: it holds stats_ and samples_
+  double imbalanceSeconds_ = 0;        // Σ over stages: last finish − first finish
 };
 
 }  // namespace misalloc

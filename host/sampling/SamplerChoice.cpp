@@ -1,4 +1,4 @@
-#include "render/SamplerChoice.h"
+#include "sampling/SamplerChoice.h"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,8 @@
 #include <map>
 
 #include "Error.h"
-#include "render/TiledSampler.h"
+#include "sampling/HostSampler.h"
+#include "sampling/TiledSampler.h"
 
 namespace misalloc {
 namespace {
@@ -34,11 +35,11 @@ DeviceError explain(const cl::Error& e, const Device& device, const Scene& scene
     case CL_INVALID_BUFFER_SIZE:
     case CL_MEM_OBJECT_ALLOCATION_FAILURE:
     case CL_OUT_OF_RESOURCES:
-      return DeviceError(fmt::format(
-          "{} for {} pixels: a buffer is larger than {} can hold: at most {} in one buffer, {} in all ({})",
-          bufferOption(scene, config), scene.pixelCount(), device.name(),
-          mebibytes(device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>()),
-          mebibytes(device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>()), code));
+      return DeviceError(
+          fmt::format("{} for {} pixels: a buffer is larger than {} can hold: at most {} in one buffer, {} in all ({})",
+                      bufferOption(scene, config), scene.pixelCount(), device.name(),
+                      mebibytes(device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>()),
+                      mebibytes(device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>()), code));
     default:
       return DeviceError(code);
   }

@@ -1,4 +1,4 @@
-#include "alloc/GridSearch.h"
+#include "sampling/GridSearch.h"
 
 #include <fmt/format.h>
 
@@ -200,7 +200,7 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   }
   // g of sample x at the 16 combinations of lane block l0 + 16 v, batched as the kernel
   // batches them.
-  auto quotients = [&](const float* x, int l0, int lane, float (&g)[kGridVectors]) {
+  auto quotients = [&](const float* x, int l0, int lane, float(&g)[kGridVectors]) {
     float p[kGridVectors];
     for (int v = 0; v < kGridVectors; ++v) {
       int l = l0 + 16 * v + lane;
@@ -316,14 +316,14 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
   out.selected[pixel] = fallbacks == 0 ? best : -1;
   out.fallbacks[pixel] = fallbacks;
   for (int k = 0; k < m; ++k)
-    out.alpha[std::size_t(pixel) * m + k] = fallbacks == 0 ? setup.lanes.alpha[k * setup.lanes.paddedSize + best]
-                                                           : 1.0f / m;
+    out.alpha[std::size_t(pixel) * m + k] =
+        fallbacks == 0 ? setup.lanes.alpha[k * setup.lanes.paddedSize + best] : 1.0f / m;
 }
 
 // The pooled score of combination l over window w: the kernel's pooledScore.
 float pooledScore(const std::vector<float>& scores, const std::vector<float>& scales,
-                  const std::vector<unsigned>& fallbacks, kern::PoolWindow w, int width, int paddedSize,
-                  float scaleMin, int l) {
+                  const std::vector<unsigned>& fallbacks, kern::PoolWindow w, int width, int paddedSize, float scaleMin,
+                  int l) {
   float sum = 0.0f;
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x) {
@@ -363,12 +363,13 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
         sumD2 = std::fma(d, d, sumD2);
         count += 1.0f;
       }
-    skipped = kern::skipsAdapting(top, pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal),
-                                  float(pooling.minGain), sumD, sumD2, count);
+    skipped =
+        kern::skipsAdapting(top, pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal),
+                            float(pooling.minGain), sumD, sumD2, count);
   }
   for (int k = 0; k < m; ++k)
-    out.alpha[std::size_t(pixel) * m + k] = best < 0 ? in.alpha[std::size_t(pixel) * m + k]
-                                            : (skipped ? 1.0f / m : setup.lanes.alpha[k * padded + best]);
+    out.alpha[std::size_t(pixel) * m + k] =
+        best < 0 ? in.alpha[std::size_t(pixel) * m + k] : (skipped ? 1.0f / m : setup.lanes.alpha[k * padded + best]);
   out.selected[pixel] = best < 0 ? in.selected[pixel] : (skipped ? -1 : best);
   out.fallbacks[pixel] = best < 0 ? in.fallbacks[pixel] : 0u;
   out.skipped[pixel] = (unsigned char)skipped;
@@ -496,10 +497,10 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
                    cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)), cl_float(pooling->minGain), alphaFinal,
                    selectedFinal, fallbacksFinal, skippedOut);
     cl::Event pooled;
-    device_.queue.enqueueNDRangeKernel(poolKernel_, cl::NullRange,
-                                       cl::NDRange((std::size_t(pixels) + kPoolLocalSize - 1) / kPoolLocalSize *
-                                                   kPoolLocalSize),
-                                       cl::NDRange(kPoolLocalSize), nullptr, &pooled);
+    device_.queue.enqueueNDRangeKernel(
+        poolKernel_, cl::NullRange,
+        cl::NDRange((std::size_t(pixels) + kPoolLocalSize - 1) / kPoolLocalSize * kPoolLocalSize),
+        cl::NDRange(kPoolLocalSize), nullptr, &pooled);
     pooled.wait();
     result.seconds += eventSeconds(pooled);
     device_.queue.enqueueReadBuffer(skippedOut, CL_FALSE, 0, pixels, out.skipped.data());
@@ -516,7 +517,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
 // What the reference keeps from run to run, as the kernel keeps it on the device.
 struct GridSearchReference::RunningSums {
   std::vector<kern::PixelSummary> summaries;
-  std::vector<float> sums;          // runningSumIndex
+  std::vector<float> sums;            // runningSumIndex
   std::vector<float> scores, scales;  // the last search's, as the kernel keeps them
 };
 

@@ -3,7 +3,7 @@
 #include <optional>
 #include <vector>
 
-#include "render/Stage.h"
+#include "sampling/Stage.h"
 
 namespace misalloc {
 
@@ -35,7 +35,7 @@ class TileQueue {
 
   mutable std::mutex mutex_;
   const int pixels_, granularity_;
-  int cursor_ = 0;                    // pixels [0, cursor_) are handed out, but for givenBack_
+  int cursor_ = 0;                     // pixels [0, cursor_) are handed out, but for givenBack_
   std::vector<PixelRange> givenBack_;  // handed out first
   std::vector<double> rates_;
   std::vector<unsigned char> retired_;

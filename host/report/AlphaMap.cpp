@@ -1,4 +1,4 @@
-#include "render/AlphaMap.h"
+#include "report/AlphaMap.h"
 
 #include <cmath>
 

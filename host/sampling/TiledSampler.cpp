@@ -1,4 +1,4 @@
-#include "render/TiledSampler.h"
+#include "sampling/TiledSampler.h"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 
 #include "Constants.h"
 #include "Error.h"
-#include "render/TileQueue.h"
+#include "sampling/TileQueue.h"
 
 namespace misalloc {
 namespace {
@@ -103,9 +103,9 @@ StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int fi
     for (size_t d = 0; d < D; ++d)
       if (live(d)) threads.emplace_back(work, d);
     if (threads.empty())
-      throw DeviceError(fmt::format("every device failed; the first: {}",
-                                    *std::find_if(failures_.begin(), failures_.end(),
-                                                  [](const std::string& f) { return !f.empty(); })));
+      throw DeviceError(fmt::format(
+          "every device failed; the first: {}",
+          *std::find_if(failures_.begin(), failures_.end(), [](const std::string& f) { return !f.empty(); })));
     for (std::thread& t : threads) t.join();
   }
   if (programmingError) std::rethrow_exception(programmingError);
@@ -168,8 +168,8 @@ GridSearchResult TiledSampler::search(const StoredSampleLayout& layout, const st
                                       const std::optional<PooledSelection>& pooling) {
   // The grid search's sums of earlier searches live on the member that ran them.
   if (!live(0))
-    throw DeviceError(fmt::format("{} runs the grid search and failed: {}", members_[0]->deviceShares().front().name,
-                                  failures_[0]));
+    throw DeviceError(
+        fmt::format("{} runs the grid search and failed: {}", members_[0]->deviceShares().front().name, failures_[0]));
   loadMembers(1);
   return members_[0]->search(layout, costs, rule, pooling);
 }

@@ -44,12 +44,12 @@ struct StageResult {
 // One device's part in the stages since a sampler's reset(), for the report.
 struct DeviceShare {
   std::string name;
-  std::string launch;            // its local size and why (cl/LaunchShape.h); empty on the host
-  long long pixelStages = 0;     // pixels it ran, summed over the stages
-  long long samples = 0;         // samples it took
-  int tiles = 0;                 // kernel launches
-  double kernelSeconds = 0;      // its own device time
-  std::string failure;           // why it stopped, if it failed: its tiles ran elsewhere
+  std::string launch;         // its local size and why (cl/LaunchShape.h); empty on the host
+  long long pixelStages = 0;  // pixels it ran, summed over the stages
+  long long samples = 0;      // samples it took
+  int tiles = 0;              // kernel launches
+  double kernelSeconds = 0;   // its own device time
+  std::string failure;        // why it stopped, if it failed: its tiles ran elsewhere
 };
 
 // What a sampler keeps beyond the stage estimates, for the allocations.

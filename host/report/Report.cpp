@@ -1,8 +1,8 @@
-#include "render/Report.h"
+#include "report/Report.h"
 
 #include <cmath>
 
-#include "render/ImageMetrics.h"
+#include "report/ImageMetrics.h"
 
 namespace misalloc {
 
@@ -36,7 +36,7 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
 }
 
 // Each device's share of the pixels and samples; with several, how far apart they
-// finished (render/TiledSampler.h).
+// finished (sampling/TiledSampler.h).
 nlohmann::json devicesJson(const Rendering& r) {
   long long pixelStages = 0, samples = 0;
   for (const DeviceShare& d : r.devices) pixelStages += d.pixelStages, samples += d.samples;

@@ -1,4 +1,4 @@
-#include "render/Costs.h"
+#include "sampling/Costs.h"
 
 #include <fmt/format.h>
 
@@ -39,8 +39,7 @@ std::vector<double> measureCosts(StageSampler& calibration, int spp) {
 }
 
 std::vector<double> parseCosts(const std::string& list, int techniqueCount) {
-  std::vector<double> costs =
-      parseNumberList("--cost", list, list, size_t(techniqueCount), "one cost per technique");
+  std::vector<double> costs = parseNumberList("--cost", list, list, size_t(techniqueCount), "one cost per technique");
   for (double c : costs)
     if (c <= 0) throw InputError(fmt::format("--cost {}: costs must be positive, got {}", list, c));
   return costs;

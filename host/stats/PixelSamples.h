@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "alloc/PixelStats.h"
+#include "stats/PixelStats.h"
 
 namespace misalloc {
 

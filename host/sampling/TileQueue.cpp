@@ -1,4 +1,4 @@
-#include "render/TileQueue.h"
+#include "sampling/TileQueue.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "render/RunningStats.h"
+#include "stats/RunningStats.h"
 
 #include "KernelCode.h"
 

@@ -1,4 +1,4 @@
-#include "render/ImageMetrics.h"
+#include "report/ImageMetrics.h"
 
 #include <fmt/format.h>
 

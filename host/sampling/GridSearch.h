@@ -69,7 +69,7 @@ struct StoredSampleLayout {
 // last search's scores and scale for the pooled selection.
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize);
 
-// Rule (b)'s selection over neighbourhoods (alloc/Pooling.h says why) and the skip
+// Rule (b)'s selection over neighbourhoods (stats/Pooling.h says why) and the skip
 // rule, for the pixels of a width × height image: each pixel takes the combination
 // with the least Σ_q (Σ_k c_k α_k) V_q over the ranked pixels q within `radius`, and
 // keeps equal weights where that is not at least the fraction `minGain` below its

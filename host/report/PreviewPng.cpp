@@ -1,4 +1,4 @@
-#include "render/PreviewPng.h"
+#include "report/PreviewPng.h"
 
 #include <algorithm>
 #include <cmath>

@@ -24,7 +24,7 @@ struct SceneOptions {
 struct Scene {
   SceneOptions options;
   std::string envmapPath;  // the resolved file, empty for procedural maps
-  Envmap envmap;  // its image keeps width and height; the texels live in `tables`
+  Envmap envmap;           // its image keeps width and height; the texels live in `tables`
   EnvmapTables tables;
   BrdfGrid grid;
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal

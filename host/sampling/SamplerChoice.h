@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "cl/Device.h"
-#include "render/Sampler.h"
+#include "sampling/Sampler.h"
 
 namespace misalloc {
 

@@ -1,4 +1,4 @@
-#include "alloc/PixelStats.h"
+#include "stats/PixelStats.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,7 +2,7 @@
 #include <string>
 #include <vector>
 
-#include "render/Sampler.h"
+#include "sampling/Sampler.h"
 
 namespace misalloc {
 

@@ -1,10 +1,10 @@
 #pragma once
 // The sampler's running sums and stored samples (kernels/stats.h) read back as the
-// allocation rules' per-pixel inputs (host/alloc/PixelStats.h, PixelSamples.h).
+// allocation rules' per-pixel inputs (host/stats/PixelStats.h, PixelSamples.h).
 #include <vector>
 
-#include "alloc/PixelSamples.h"
-#include "alloc/PixelStats.h"
+#include "stats/PixelSamples.h"
+#include "stats/PixelStats.h"
 
 namespace misalloc {
 

@@ -1,4 +1,4 @@
-#include "render/Scene.h"
+#include "scene/Scene.h"
 
 #include <fmt/format.h>
 

@@ -1,10 +1,11 @@
 // HostSampler: the C++ reference of kernels/sample.cl, through host/KernelCode.h.
+#include "sampling/HostSampler.h"
+
 #include <algorithm>
 #include <chrono>
 
 #include "KernelCode.h"
-#include "render/KernelViews.h"
-#include "render/Sampler.h"
+#include "sampling/KernelViews.h"
 
 namespace misalloc {
 
@@ -57,9 +58,9 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     b.rhoD = p.rhoD;
     b.rhoS = p.rhoS;
     b.n = p.n;
-    const kern::StageCounts c =
-        kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
-                              config_.estimator == Estimator::OneSample, config_.estimator == Estimator::CountIndependent);
+    const kern::StageCounts c = kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M,
+                                                      plan.stageSamples, config_.estimator == Estimator::OneSample,
+                                                      config_.estimator == Estimator::CountIndependent);
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {

@@ -1,4 +1,4 @@
-#include "alloc/PixelSamples.h"
+#include "stats/PixelSamples.h"
 
 #include <limits>
 

@@ -1,4 +1,4 @@
-#include "alloc/Pooling.h"
+#include "stats/Pooling.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,0 +1,66 @@
+#pragma once
+#include <CL/opencl.hpp>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cl/Device.h"
+#include "sampling/StageSampler.h"
+
+namespace misalloc {
+
+// The `-D` options that compile kernels/sample.cl for exactly this scene, estimator,
+// statistics and work-group size.
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize);
+
+// A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
+// that share a context (the sub-devices of one device, cl/Device.h) share one copy, so
+// that their caches hold one set of tables.
+class SceneBuffers {
+ public:
+  SceneBuffers(const Device& device, const Scene& scene);
+  cl_context context() const { return context_; }
+
+  cl::Buffer texels, cdfTable, aliasTable, brdfParams;
+
+ private:
+  cl_context context_;
+};
+
+// Runs kernels/sample.cl (sampleStage) on a device. The program is built and the
+// scene uploaded once; each run() takes one stage for every pixel.
+class Sampler : public StageSampler {
+ public:
+  // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
+  // `sceneBuffers`: made for this device's context, shared with other samplers; null:
+  // its own.
+  Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
+          std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
+  int localSize() const { return localSize_; }
+  std::vector<double> statistics() override;
+  std::vector<float> storedSamples() override;
+  std::vector<DeviceShare> deviceShares() const override;
+
+ protected:  // tests/test_devices.cpp injects failures into runPixels
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+  void loadStatistics(const std::vector<double>& stats) override;
+  void loadStoredSamples(const std::vector<float>& samples) override;
+  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
+                          const std::optional<PooledSelection>& pooling) override;
+  void forgetStages() override;
+
+ private:
+  const Device& device_;
+  std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
+  int localSize_;
+  bool doubleSums_;
+  cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
+  std::shared_ptr<const SceneBuffers> sceneBuffers_;
+  cl::Buffer stats_, samples_;
+  // A stage's per-pixel inputs and outputs, whole-image sized so that a tile writes its rows.
+  cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
+  DeviceShare share_;  // since reset()
+};
+
+}  // namespace misalloc
