@@ -33,6 +33,7 @@ class SceneBuffers {
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
+  // `device` and `scene` must outlive the sampler (ARCHITECTURE.md, Lifetimes).
   // `sceneBuffers`: made for this device's context, shared with other samplers; null:
   // its own.
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
