@@ -39,6 +39,7 @@ std::unique_ptr<StageSampler> makeSampler(const std::string& config, const Scene
                                           std::vector<std::unique_ptr<Device>>& keep) {
   if (config == "cpu:2 [1]") {
     keep.push_back(std::make_unique<Device>(std::move(openSubDevices("cpu", 2).front())));
+    keep.back()->whole = nullptr;  // one core for everything, the grid search included
     return std::make_unique<Sampler>(*keep.back(), scene, sc);
   }
   static std::map<std::string, std::unique_ptr<SamplerDevices>> lists;

@@ -26,7 +26,7 @@ std::vector<cl::Platform> platforms() {
 bool hasType(const cl::Device& d, cl_device_type type) { return (d.getInfo<CL_DEVICE_TYPE>() & type) != 0; }
 
 Device withQueue(const cl::Platform& platform, const cl::Device& device) {
-  Device dev{platform, device, {}, {}, {}};
+  Device dev{platform, device, {}, {}, {}, nullptr};
   dev.context = cl::Context(dev.device);
   dev.queue = cl::CommandQueue(dev.context, dev.device, CL_QUEUE_PROFILING_ENABLE);
   return dev;
@@ -122,13 +122,20 @@ std::vector<Device> openSubDevices(const std::string& spec, int count) {
   std::vector<cl::Device> parts;
   whole.device.createSubDevices(equally, &parts);
   parts.resize(size_t(count));
-  // One context: buffers made in it serve every part (sampling/Sampler.h, SceneBuffers).
-  const cl::Context shared(parts);
+  // One context for the parts and the whole: buffers made in it serve every part
+  // (sampling/Sampler.h, SceneBuffers), and the whole device can run what is not split
+  // into tiles over them (the grid search) on all its compute units.
+  std::vector<cl::Device> members = parts;
+  members.push_back(whole.device);
+  const cl::Context shared(members);
+  auto wholeInShared = std::make_shared<Device>(
+      Device{whole.platform, whole.device, shared, cl::CommandQueue(shared, whole.device, CL_QUEUE_PROFILING_ENABLE),
+             "", nullptr});
   std::vector<Device> devices;
   for (int i = 0; i < count; ++i) {
     Device part{whole.platform, parts[size_t(i)], shared,
                 cl::CommandQueue(shared, parts[size_t(i)], CL_QUEUE_PROFILING_ENABLE),
-                fmt::format("sub-device {}/{}", i + 1, count)};
+                fmt::format("sub-device {}/{}", i + 1, count), wholeInShared};
     devices.push_back(std::move(part));
   }
   return devices;

@@ -1,5 +1,6 @@
 #pragma once
 #include <CL/opencl.hpp>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@ struct Device {
   cl::Context context;
   cl::CommandQueue queue;
   std::string part;  // a sub-device's place in its device, e.g. "sub-device 1/2"; else empty
+  // A sub-device's whole device, in the same context; else null.
+  std::shared_ptr<const Device> whole;
 
   std::string name() const;
 };

@@ -96,7 +96,10 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
   share_.name = device.name();
   if (config.gridSize > 0)
-    gridSearch_ = std::make_unique<GridSearch>(device, scene.techniqueCount(), scene.pixelCount(), config.gridSize);
+    // A sub-device searches on its whole device, which shares its context and so reads
+    // the stored samples where they are: the search is not split into tiles.
+    gridSearch_ = std::make_unique<GridSearch>(device.whole ? *device.whole : device, scene.techniqueCount(),
+                                               scene.pixelCount(), config.gridSize);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
   StagePlan empty;
