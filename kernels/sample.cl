@@ -7,6 +7,12 @@
 // MA_COSK (< 0: the texels), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the running
 // sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the
 // unused techniques, sampler, estimator and statistics away.
+//
+// No contraction of a*b + c into fma but where the code says fma: the C++ reference is
+// compiled with -ffp-contract=off too (CMakeLists.txt), so that a pixel's arithmetic is
+// the same on PoCL and on the host, bit for bit (`--device cpu,host`, tests/test_devices.cpp).
+// It costs PoCL nothing measurable (README, "Sampling kernel against its OpenMP peer").
+#pragma OPENCL FP_CONTRACT OFF
 #include "stats.h"
 
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
