@@ -93,7 +93,8 @@ int runCompare(CompareArgs& args) {
   for (const CompareCase& c : compare.cases)
     for (Method m : compare.methods)
       for (int budget : compare.budgets)
-        requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, args.devices.onHost());
+        requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, args.devices.onHost(),
+                                args.devices.samplerCount());
   requireBrdfCoverage(compare);
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);

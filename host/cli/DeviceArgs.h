@@ -23,6 +23,7 @@ class DeviceArgs {
   const std::string& spec() const { return spec_; }
   // The list names the C++ sampler (HostSampler): the grid search's sums then take host memory.
   bool onHost() const { return SamplerDevices(spec_).includesHost(); }
+  int samplerCount() const { return SamplerDevices(spec_).samplerCount(); }
 
   // A sampler on the devices asked for, opened at the first call and shared by the
   // samplers built later; they must not outlive this.

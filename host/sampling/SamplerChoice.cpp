@@ -150,6 +150,19 @@ std::string SamplerDevices::name() const {
   return joined.empty() ? list_ : joined;
 }
 
+int SamplerDevices::samplerCount() const {
+  int count = 0;
+  for (const std::string& entry : deviceEntries(list_)) {
+    if (entry == "all")
+      count += int(enumerateDevices().size());
+    else if (entry != "host" && entry.find(':') != std::string::npos)
+      count += subDeviceEntry(entry).second;
+    else
+      ++count;
+  }
+  return count;
+}
+
 bool SamplerDevices::includesHost() const {
   for (const std::string& entry : deviceEntries(list_))
     if (entry == "host") return true;

@@ -21,6 +21,9 @@ class SamplerDevices {
   // What a report names: the devices, joined by " + ".
   std::string name() const;
   bool includesHost() const;
+  // How many samplers the list makes, from the list alone (`all` asks the platforms):
+  // each holds its own running sums and stored samples.
+  int samplerCount() const;
 
  private:
   void open();
