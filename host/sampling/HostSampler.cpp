@@ -34,7 +34,7 @@ HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
 void HostSampler::forgetStages() {
   std::fill(stats_.begin(), stats_.end(), 0.0);
   if (gridSearch_) gridSearch_->reset();
-  share_ = DeviceShare{share_.name, "", 0, 0, 0, 0, ""};
+  share_ = share_.restarted();
 }
 
 StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {

@@ -6,7 +6,6 @@
 #include <numeric>
 
 #include "Constants.h"
-#include "Error.h"
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
 #include "cl/LaunchShape.h"
@@ -61,7 +60,6 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
 Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize,
                  std::shared_ptr<const SceneBuffers> sceneBuffers)
     : StageSampler(scene, config), device_(device) {
-  if (localSize < 0) throw InputError("--local-size must be at least 1, or 0 to choose per device");
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
   // Both kernels run at one size: that of the one with the running sums, the larger.
   const LaunchShape shape = chooseLocalSize(
@@ -197,7 +195,7 @@ void Sampler::forgetStages() {
   const size_t bytes = size_t(scene_.pixelCount()) * statSlots() * (doubleSums_ ? sizeof(double) : sizeof(float));
   if (bytes > 0) device_.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, bytes);
   if (gridSearch_) gridSearch_->reset();
-  share_ = DeviceShare{share_.name, share_.launch, 0, 0, 0, 0, ""};
+  share_ = share_.restarted();
 }
 
 GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,

@@ -38,7 +38,6 @@ class Sampler : public StageSampler {
   // its own.
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
           std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
-  int localSize() const { return localSize_; }
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
   std::vector<DeviceShare> deviceShares() const override;

@@ -50,6 +50,14 @@ struct DeviceShare {
   int tiles = 0;              // kernel launches
   double kernelSeconds = 0;   // its own device time
   std::string failure;        // why it stopped, if it failed: its tiles ran elsewhere
+
+  // The same device with nothing run yet (StageSampler::reset).
+  DeviceShare restarted() const {
+    DeviceShare fresh;
+    fresh.name = name;
+    fresh.launch = launch;
+    return fresh;
+  }
 };
 
 // What a sampler keeps beyond the stage estimates, for the allocations.

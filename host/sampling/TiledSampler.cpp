@@ -53,7 +53,7 @@ StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int fi
   for (size_t d = 0; d < D; ++d)
     if (!live(d)) queue.retire(int(d));
   // The running sums of a stage that keeps them live on the member that ran the tile
-  // until shareStatistics: a member that fails loses every tile it ran.
+  // until gatherStatistics: a member that fails loses every tile it ran.
   const bool losesTiles = plan.keepStatistics && keepsStatistics(config_);
   if (losesTiles) loadMembers(members_.size());
   std::vector<std::vector<PixelRange>> ran(D);
