@@ -1,9 +1,10 @@
 // What the envmap pdf of [Kar19] costs: building each map's tables (texel probabilities
-// and the alias table or CDFs) with the plain and the compensated pdf, against one
-// 256×256, 200 spp `equal` render of the default scene. The compensated pdf adds L̄ and
-// the subtraction of eq. 14 to the build; sampling with it should cost what sampling
-// with the plain pdf does (the same kernel reads tables of the same size), which the
-// renders of each map with each pdf check. Run with interleaved repetitions, so that a
+// and the alias table or CDFs) with the plain, the compensated and the optimal pdf (its
+// bank for seed000 at 256×256), against one 256×256, 200 spp `equal` render of the
+// default scene. The compensated pdf adds L̄ and the subtraction of eq. 14 to the
+// build; sampling with it should cost what sampling with the plain pdf does (the same
+// kernel reads tables of the same size), which the renders of each map with each pdf
+// check. The optimal pdf's sampler draws a block, then a texel in it. Run with interleaved repetitions, so that a
 // machine whose load changes slows both pdfs alike:
 //
 //   build/bench/misalloc_bench_envmap_pdf [--device cpu] --benchmark_repetitions=3
@@ -33,7 +34,10 @@ const Envmap& loadedMap(const std::string& name) {
 void benchTables(benchmark::State& state, const std::string& map, const std::string& pdf, EnvmapSampler sampler) {
   const Envmap& envmap = loadedMap(map);
   const EnvmapPdf parsed = parseEnvmapPdf(pdf);
-  for (auto _ : state) benchmark::DoNotOptimize(buildEnvmapTables(envmap, sampler, parsed));
+  const BrdfGrid grid = makeBrdfGrid("seed000", 256, 256);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(parsed.optimal() ? buildOptimalEnvmapTables(envmap, sampler, grid, {0, 0, 1})
+                                              : buildEnvmapTables(envmap, sampler, parsed));
 }
 
 // One 256×256, 200 spp `equal` render of `map` × seed000 with `pdf`, per iteration. Both
@@ -67,7 +71,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> maps = shippedEnvmapNames();
   maps.push_back("sun");
   for (const std::string& map : maps)
-    for (const char* pdf : {"plain", "compensated"})
+    for (const char* pdf : {"plain", "compensated", "optimal"})
       for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
         benchmark::RegisterBenchmark(
             ("tables/" + map + "/" + pdf + (sampler == EnvmapSampler::Cdf ? "/cdf" : "/alias")).c_str(),
@@ -75,7 +79,7 @@ int main(int argc, char** argv) {
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
   for (const std::string& map : maps)
-    for (const char* pdf : {"plain", "compensated"})
+    for (const char* pdf : {"plain", "compensated", "optimal"})
       benchmark::RegisterBenchmark(("render/" + map + "/" + pdf + "/equal/256x256/200spp").c_str(),
                                    [map, pdf](benchmark::State& s) { benchRender(s, map, pdf); })
           ->Unit(benchmark::kMillisecond)

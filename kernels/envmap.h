@@ -1,7 +1,10 @@
 // The lat-long environment map: radiance lookup, its sampling pdf (∝ luminance ×
 // sin θ per texel, uniform in (φ, θ) inside the texel) and the two samplers with that
 // same pdf: an O(1) alias table and marginal/conditional CDFs with binary searches.
-// Host side: host/scene/Envmap.h, host/scene/EnvmapDistribution.h.
+// With the optimal pdf ([Kar19] eq. 9), a bank of tables over blocks of texels, one
+// per BRDF bin and envmap share, picks the block, and the plain pdf the texel in it.
+// Host side: host/scene/Envmap.h, host/scene/EnvmapDistribution.h,
+// host/scene/OptimalBank.h.
 #include "namespace_check.h"
 #ifndef MA_ENVMAP_H
 #define MA_ENVMAP_H
@@ -11,14 +14,26 @@
 
 // Row 0 is the zenith: texel (col, row) covers φ ∈ 2π[col, col+1)/W and
 // θ ∈ π[row, row+1)/H, with z up.
+//
+// The optimal pdf's bank (bankShares > 0) lays the same buffers out differently:
+// texels[4t + 3] is the texel's probability within its block; aliasTable starts with
+// each block's alias table over its 2^L × 2^L slots (both samplers draw the texel in
+// the block with it), then, for the alias sampler, each entry's alias table over the
+// blocks; cdfTable holds, for the CDF sampler, each entry's CDFs over the blocks;
+// blockProbs each entry's probability of each block.
 typedef struct {
   MA_GLOBAL const float* texels;        // per texel: R, G, B, probability of the texel
   MA_GLOBAL const float* cdfTable;      // CDF: marginal (H+1) then conditionals H×(W+1)
   MA_GLOBAL const ma_uint* aliasTable;  // alias: per bucket, acceptance probability bits and alias
   int width, height;
   int useCdf;
-  int cdfStepsRow, cdfStepsCol;  // ceil(log2(H)), ceil(log2(W)): fixed-step binary searches
-  float coskExponent;            // ≥ 0: analytic radiance cos^K θ on the upper hemisphere ([HS14] App. D)
+  int cdfStepsRow, cdfStepsCol;       // ceil(log2(H)), ceil(log2(W)) (bank: of the blocks): fixed-step searches
+  float coskExponent;                 // ≥ 0: analytic radiance cos^K θ on the upper hemisphere ([HS14] App. D)
+  int bankShares;                     // the bank's shares C_i = (i+1)/(bankShares+1) per BRDF bin; 0: no bank
+  int blockLog2;                      // its blocks are 2^L × 2^L texels
+  MA_GLOBAL const float* blockProbs;  // per entry, per block: the probability of drawing the block
+  int brdfBin;                        // the pixel's BRDF bin: its row of the bank
+  int bankEntry;                      // the entry its stage samples with (bankEntryOf)
 } EnvmapView;
 
 typedef struct {
@@ -42,6 +57,31 @@ MA_FN int texelOfDirection(EnvmapView env, MaVec3 w) {
   return row * env.width + col;
 }
 
+MA_FN int blocksAcross(EnvmapView env) { return (env.width + (1 << env.blockLog2) - 1) >> env.blockLog2; }
+MA_FN int blocksDown(EnvmapView env) { return (env.height + (1 << env.blockLog2) - 1) >> env.blockLog2; }
+
+MA_FN int blockOfTexel(EnvmapView env, int t) {
+  int row = t / env.width;
+  int col = t - row * env.width;
+  return (row >> env.blockLog2) * blocksAcross(env) + (col >> env.blockLog2);
+}
+
+// The pixel's stage samples with the entry of its BRDF bin whose share C is nearest
+// the stage's envmap fraction α_0: [Kar19] eq. 9 for the C that is actually run.
+MA_FN int bankEntryOf(EnvmapView env, float envmapFraction) {
+  int share = (int)(envmapFraction * (float)(env.bankShares + 1) + 0.5f) - 1;
+  share = share < 0 ? 0 : (share >= env.bankShares ? env.bankShares - 1 : share);
+  return env.brdfBin * env.bankShares + share;
+}
+
+// The probability that envmap sampling draws texel t.
+MA_FN float texelProbability(EnvmapView env, int t) {
+  float p = env.texels[4 * t + 3];
+  if (env.bankShares > 0)
+    p *= env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + blockOfTexel(env, t)];
+  return p;
+}
+
 // A texel picked with probability P is spread uniformly over its (u, v) area 1/(WH),
 // and dω = 2π² sin θ du dv, so p(ω) = P W H / (2π² sin θ).
 MA_FN float envmapPdfOfTexel(EnvmapView env, float texelProbability, float sinTheta) {
@@ -58,7 +98,7 @@ MA_FN EnvmapHit envmapTexelHit(EnvmapView env, int t, MaVec3 w) {
     hit.g = env.texels[4 * t + 1];
     hit.b = env.texels[4 * t + 2];
   }
-  hit.pdf = envmapPdfOfTexel(env, env.texels[4 * t + 3], ma_sqrt(w.x * w.x + w.y * w.y));
+  hit.pdf = envmapPdfOfTexel(env, texelProbability(env, t), ma_sqrt(w.x * w.x + w.y * w.y));
   return hit;
 }
 
@@ -66,10 +106,10 @@ MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) { return envmapTexelHit(e
 
 // Vose alias table. The bucket comes from a full 32-bit integer and the coin from an
 // independent uniform: one 24-bit uniform for both is biased for large tables.
-MA_FN int sampleAliasTable(EnvmapView env, ma_uint bucketBits, float coin) {
-  ma_uint bucket = mulHi(bucketBits, (ma_uint)(env.width * env.height));
-  float accept = ma_as_float(env.aliasTable[2 * bucket]);
-  return coin < accept ? (int)bucket : (int)env.aliasTable[2 * bucket + 1];
+MA_FN int sampleAliasTable(MA_GLOBAL const ma_uint* table, ma_uint buckets, ma_uint bucketBits, float coin) {
+  ma_uint bucket = mulHi(bucketBits, buckets);
+  float accept = ma_as_float(table[2 * bucket]);
+  return coin < accept ? (int)bucket : (int)table[2 * bucket + 1];
 }
 
 // The last index i in [0, n) with cdf[i] ≤ u, cdf[0] = 0 ≤ u < 1 = cdf[n]: a
@@ -85,12 +125,13 @@ MA_FN int searchCdf(MA_GLOBAL const float* cdf, int n, int steps, float u) {
   return base;
 }
 
-MA_FN int sampleCdfTable(EnvmapView env, float uRow, float uCol) {
-  MA_GLOBAL const float* marginal = env.cdfTable;
-  int row = searchCdf(marginal, env.height, env.cdfStepsRow, uRow);
-  MA_GLOBAL const float* conditional = env.cdfTable + (env.height + 1) + row * (env.width + 1);
-  int col = searchCdf(conditional, env.width, env.cdfStepsCol, uCol);
-  return row * env.width + col;
+// A cell of a width × height grid from its marginal and conditional CDFs.
+MA_FN int sampleCdfTable(EnvmapView env, MA_GLOBAL const float* marginal, int width, int height, float uRow,
+                         float uCol) {
+  int row = searchCdf(marginal, height, env.cdfStepsRow, uRow);
+  MA_GLOBAL const float* conditional = marginal + (height + 1) + row * (width + 1);
+  int col = searchCdf(conditional, width, env.cdfStepsCol, uCol);
+  return row * width + col;
 }
 
 typedef struct {
@@ -98,21 +139,49 @@ typedef struct {
   int texel;  // the texel drawn, which holds w
 } EnvmapSample;
 
+// A direction in texel t, at the jitter's place in its (u, v) square.
+MA_FN EnvmapSample envmapSampleIn(EnvmapView env, int t, float jitterU, float jitterV) {
+  int row = t / env.width;
+  int col = t - row * env.width;
+  float u = ((float)col + jitterU) / (float)env.width;
+  float v = ((float)row + jitterV) / (float)env.height;
+  EnvmapSample s;
+  s.w = latLongDirection(u, v);
+  s.texel = t;
+  return s;
+}
+
+// The bank: a block from the entry's table (rnd.v[0], v[1]), a slot of the block from its
+// alias table: the top 2L bits of rnd.v[2] pick the slot, the rest are the coin, exactly
+// uniform and independent of it. The jitter in the texel takes 16 bits of rnd.v[3] each.
+MA_FN EnvmapSample sampleEnvmapBank(EnvmapView env, MaRandom4 rnd) {
+  int across = blocksAcross(env), down = blocksDown(env), blocks = across * down;
+  int slotBits = 2 * env.blockLog2;
+  int block = env.useCdf ? sampleCdfTable(env, env.cdfTable + env.bankEntry * ((down + 1) + down * (across + 1)),
+                                          across, down, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
+                         : sampleAliasTable(env.aliasTable + 2 * ((blocks << slotBits) + env.bankEntry * blocks),
+                                            (ma_uint)blocks, rnd.v[0], uniformFloat(rnd.v[1]));
+  MA_GLOBAL const ma_uint* slots = env.aliasTable + 2 * (block << slotBits);
+  int slot = (int)(rnd.v[2] >> (32 - slotBits));
+  float accept = ma_as_float(slots[2 * slot]);
+  slot = uniformFloat(rnd.v[2] << slotBits) < accept ? slot : (int)slots[2 * slot + 1];
+  int blockRow = block / across;
+  int row = (blockRow << env.blockLog2) + (slot >> env.blockLog2);
+  int col = ((block - blockRow * across) << env.blockLog2) + (slot & ((1 << env.blockLog2) - 1));
+  return envmapSampleIn(env, row * env.width + col, (float)(rnd.v[3] >> 16) * (1.0f / 65536.0f),
+                        (float)(rnd.v[3] & 0xffffu) * (1.0f / 65536.0f));
+}
+
 // The pdf of a drawn direction is that of the texel it was drawn in (as pbrt-v4's
 // ImageInfiniteLight::SampleLi): envmapTexelHit then needs no texelOfDirection, whose
 // inverse trigonometry and dependent gather would follow the alias table's gather.
 // Both agree except where rounding puts w on a neighbouring texel's edge.
 MA_FN EnvmapSample sampleEnvmap(EnvmapView env, MaRandom4 rnd) {
-  int t = env.useCdf ? sampleCdfTable(env, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
-                     : sampleAliasTable(env, rnd.v[0], uniformFloat(rnd.v[1]));
-  int row = t / env.width;
-  int col = t - row * env.width;
-  float u = ((float)col + uniformFloat(rnd.v[2])) / (float)env.width;
-  float v = ((float)row + uniformFloat(rnd.v[3])) / (float)env.height;
-  EnvmapSample s;
-  s.w = latLongDirection(u, v);
-  s.texel = t;
-  return s;
+  if (env.bankShares > 0) return sampleEnvmapBank(env, rnd);
+  int t = env.useCdf
+              ? sampleCdfTable(env, env.cdfTable, env.width, env.height, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
+              : sampleAliasTable(env.aliasTable, (ma_uint)(env.width * env.height), rnd.v[0], uniformFloat(rnd.v[1]));
+  return envmapSampleIn(env, t, uniformFloat(rnd.v[2]), uniformFloat(rnd.v[3]));
 }
 
 #endif

@@ -69,6 +69,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float N = (float)c.stageSamples;
   float alpha[MA_MAX_TECHNIQUES];
   stageFractions(c, alpha);
+  if (env.bankShares > 0) env.bankEntry = bankEntryOf(env, alpha[0]);
   MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
   SampleValue s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
   // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent

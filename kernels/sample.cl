@@ -4,8 +4,9 @@
 //
 // Compile-time options (sampleKernelOptions in host/sampling/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
-// MA_COSK (< 0: the texels), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the running
-// sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the
+// MA_COSK (< 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
+// bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the
+// running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the
 // unused techniques, sampler, estimator and statistics away.
 //
 // No contraction of a*b + c into fma but where the code says fma: the C++ reference is
@@ -25,10 +26,10 @@ enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, S
 // Everything one sample needs, re-read from global memory (cached) at each sample for
 // the same reason. Sample j of `technique`'s samples (one-sample: of the stage).
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
-                                       __global const uint* aliasTable, int width, int height,
-                                       __global const float* brdfParams, MaVec3 mirror, __global const int* counts,
-                                       __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-                                       int pixel, int technique, int j) {
+                                       __global const uint* aliasTable, __global const float* blockProbs, int width,
+                                       int height, __global const float* brdfParams, MaVec3 mirror,
+                                       __global const int* counts, __global const uint* firstIndex, int stageSamples,
+                                       uint seedLo, uint seedHi, int pixel, int technique, int j) {
   EnvmapView env;
   env.texels = texels;
   env.cdfTable = cdfTable;
@@ -39,6 +40,11 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.cdfStepsRow = MA_CDF_STEPS_ROW;
   env.cdfStepsCol = MA_CDF_STEPS_COL;
   env.coskExponent = MA_COSK;
+  env.bankShares = MA_BANK_SHARES;
+  env.blockLog2 = MA_BANK_BLOCK_LOG2;
+  env.blockProbs = blockProbs;
+  env.brdfBin = (int)brdfParams[4 * pixel + 3];
+  env.bankEntry = 0;
 
   TechniqueSet ts;
   ts.techniqueCount = MA_TECHNIQUES;
@@ -50,8 +56,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   b.rhoS = brdfParams[4 * pixel + 1];
   b.n = brdfParams[4 * pixel + 2];
 
-  StageCounts c = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
-                                  MA_COUNT_INDEPENDENT);
+  StageCounts c =
+      loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT);
 #if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
 #else
@@ -61,11 +67,11 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
-    __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable, int width,
-    int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
-    __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-    int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate, __global ma_acc* moments,
-    __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity) {
+    __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable,
+    __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
+    float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
+    uint seedLo, uint seedHi, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
+    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
@@ -91,9 +97,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
-      SampleContribution c =
-          sampleOfPixel(texels, cdfTable, aliasTable, width, height, brdfParams, makeVec3(mirrorX, mirrorY, mirrorZ),
-                        counts, firstIndex, stageSamples, seedLo, seedHi, pixel, k, jk);
+      SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, width, height, brdfParams,
+                                           makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
+                                           seedLo, seedHi, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;

@@ -13,8 +13,10 @@
 namespace misalloc::test {
 
 inline Scene smallScene(const std::string& envmap, const std::string& grid, int w, int h, bool split = false,
-                        EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0) {
+                        EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0,
+                        const std::string& envmapPdf = "plain") {
   SceneOptions o;
+  o.envmapPdf = parseEnvmapPdf(envmapPdf);
   o.envmap = envmap;
   o.grid = grid;
   o.width = w;

@@ -53,10 +53,20 @@ Rendering renderWith(const Scene& scene, Method method, Estimator estimator, int
   return render(sampler, method, options, spp, seed);
 }
 
+// Every method that samples the BRDF, with each estimator it takes.
+const std::vector<std::pair<Method, Estimator>> kMethodsWithBrdfSampling = {
+    {Method::Brdf, Estimator::MultiSample},       {Method::Equal, Estimator::MultiSample},
+    {Method::Equal, Estimator::OneSample},        {Method::Heuristic, Estimator::MultiSample},
+    {Method::SigmaSqrtC, Estimator::MultiSample}, {Method::Linear, Estimator::MultiSample},
+    {Method::Exact, Estimator::MultiSample},      {Method::Oracle, Estimator::MultiSample}};
+
 }  // namespace
 
-TEST_CASE("the option --envmap-pdf parses plain, compensated and compensated:C", "[compensated]") {
+TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C and optimal", "[compensated]") {
   CHECK_FALSE(parseEnvmapPdf("plain").compensated());
+  CHECK(parseEnvmapPdf("plain").plain());
+  CHECK(parseEnvmapPdf("optimal").optimal());
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal")) == "optimal");
   CHECK(parseEnvmapPdf("compensated").compensated());
   CHECK(parseEnvmapPdf("compensated").envmapFraction == 0.5);
   CHECK(parseEnvmapPdf("compensated:0.25").envmapFraction == 0.25);
@@ -64,7 +74,7 @@ TEST_CASE("the option --envmap-pdf parses plain, compensated and compensated:C",
   CHECK(envmapPdfName(parseEnvmapPdf("compensated")) == "compensated:0.5");
   CHECK(envmapPdfName(parseEnvmapPdf("plain")) == "plain");
   for (const char* bad :
-       {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:", "optimal", "Plain"})
+       {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:", "optimal:0.5", "Plain"})
     CHECK_THROWS_AS(parseEnvmapPdf(bad), InputError);
 }
 
@@ -176,11 +186,7 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
     const char* pdf;
   };
   const Case cases[] = {{0.5, 5, 1, "compensated"}, {0.2, 50, 3, "compensated:0.25"}, {0.9, 20, 0.5, "compensated"}};
-  const std::vector<std::pair<Method, Estimator>> methods = {
-      {Method::Brdf, Estimator::MultiSample},       {Method::Equal, Estimator::MultiSample},
-      {Method::Equal, Estimator::OneSample},        {Method::Heuristic, Estimator::MultiSample},
-      {Method::SigmaSqrtC, Estimator::MultiSample}, {Method::Linear, Estimator::MultiSample},
-      {Method::Exact, Estimator::MultiSample},      {Method::Oracle, Estimator::MultiSample}};
+  const std::vector<std::pair<Method, Estimator>>& methods = kMethodsWithBrdfSampling;
   uint64_t seed = 900;
   for (const Case& c : cases) {
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
@@ -206,6 +212,73 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
         }
       }
   }
+}
+
+TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17", "[compensated][optimal][unbiased]") {
+  // One BRDF bin (a uniform grid), whose entry for each share is eq. 9 for that very
+  // BRDF: most blocks of the cos^K sky are left to BRDF sampling.
+  struct Case {
+    double rhoD, n, K;
+  };
+  const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
+  const std::vector<std::pair<Method, Estimator>>& methods = kMethodsWithBrdfSampling;
+  uint64_t seed = 1900;
+  for (const Case& c : cases)
+    for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      if (smallTestSize() && (&c != &cases[0] || s != EnvmapSampler::Alias)) {
+        seed += methods.size();
+        continue;
+      }
+      const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+      Scene scene = compensatedScene(fmt::format("cosk:{}", c.K),
+                                     fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), "optimal", s);
+      REQUIRE(scene.tables.hasBank());
+      REQUIRE(scene.tables.bankVariances.entriesWithNegativeEq5 > 0);
+      for (auto [m, e] : methods) {
+        Rendering r = renderWith(scene, m, e, 60, ++seed);
+        MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
+        double z = zScore(mean.mean, expected, mean.standardError);
+        INFO(fmt::format("rhoD {} n {} K {} optimal cdf {} {} one-sample {}: mean {} expected {} z {}", c.rhoD, c.n,
+                         c.K, s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample, mean.mean, expected,
+                         z));
+        CHECK(std::abs(z) < kMaxZ);
+      }
+    }
+}
+
+TEST_CASE("the optimal pdf refuses envmap sampling alone and split BRDF lobes, and reports its bank",
+          "[compensated][optimal][bad-input]") {
+  CHECK_THROWS_WITH(requireBrdfCoverage(parseEnvmapPdf("optimal"), 2, Method::Envmap, Estimator::MultiSample, 64, {}),
+                    Catch::Contains("--method envmap with --envmap-pdf optimal"));
+  CHECK_THROWS_WITH(compensatedScene("sun", "seed000", "optimal", EnvmapSampler::Alias, true),
+                    Catch::Contains("--envmap-pdf optimal with --split-brdf: not implemented"));
+
+  TempDir dir("optimal");
+  const std::string outputs = fmt::format("--out {} --report {} --reference none", (dir.path / "r.exr").string(),
+                                          (dir.path / "r.json").string());
+  auto split = runMisalloc(fmt::format("render --size 8x8 --spp 8 --split-brdf --envmap-pdf optimal {}", outputs));
+  CHECK(split.exitCode == 2);
+  CHECK(split.output.find("not implemented") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "r.exr"));
+
+  auto ok = runMisalloc(fmt::format("render --size 16x8 --spp 8 --method equal --envmap-pdf optimal {}", outputs));
+  INFO(ok.output);
+  REQUIRE(ok.exitCode == 0);
+  std::ifstream in(dir.path / "r.json");
+  const nlohmann::json pdf = nlohmann::json::parse(in)["scene"]["envmap_pdf"];
+  CHECK(pdf["used"] == "optimal");
+  CHECK(pdf["fallback_to_plain"] == false);
+  CHECK(pdf["bank"]["entries"] == pdf["bank"]["brdf_bins"].get<int>() * 3);
+  CHECK(pdf["bank"]["one_sample_variance_eq6_over_eq9_max"].get<double>() >= 1);
+
+  auto black =
+      runMisalloc(fmt::format("render --size 8x8 --spp 8 --method equal --envmap constant:0 "
+                              "--envmap-pdf optimal {}",
+                              outputs));
+  REQUIRE(black.exitCode == 0);
+  CHECK(black.output.find("--envmap-pdf optimal falls back to plain") != std::string::npos);
+  std::ifstream blackReport(dir.path / "r.json");
+  CHECK(nlohmann::json::parse(blackReport)["scene"]["envmap_pdf"]["fallback_to_plain"] == true);
 }
 
 TEST_CASE("compare runs each scene with each envmap pdf and compares them with equal and plain",

@@ -41,9 +41,21 @@ constexpr double kGrid24 = 0x1p24;  // uniformFloat's values are k / 2^24
 kern::EnvmapView viewOf(const EnvmapTables& tables) { return misalloc::makeEnvmapView(tables, -1); }
 
 // The texel that kernels/envmap.h's sampleEnvmap picks for these random numbers.
-int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) {
-  return view.useCdf ? kern::sampleCdfTable(view, kern::uniformFloat(r.v[0]), kern::uniformFloat(r.v[1]))
-                     : kern::sampleAliasTable(view, r.v[0], kern::uniformFloat(r.v[1]));
+int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) { return kern::sampleEnvmap(view, r).texel; }
+
+// `samples` texels drawn by the kernels' sampleEnvmap with Philox keyed (seedLo,
+// seedHi): none of probability 0, and a χ² test against p at `level`.
+void checkDrawnTexels(const kern::EnvmapView& view, const std::vector<double>& p, uint64_t samples, uint32_t seedLo,
+                      uint32_t seedHi, double level) {
+  std::vector<uint64_t> counts(p.size(), 0);
+  for (uint64_t i = 0; i < samples; ++i)
+    ++counts[sampledTexel(view, kern::philoxDraw(seedLo, seedHi, 0, 0, uint32_t(i)))];
+  uint64_t zeroWeightDraws = 0;
+  for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
+  CHECK(zeroWeightDraws == 0);
+  ChiSquare test = misalloc::test::chiSquare(counts, p, samples);
+  INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
+  if (test.degreesOfFreedom > 0) CHECK(test.pValue() > level);
 }
 
 std::vector<double> texelProbabilities(const EnvmapTables& tables) {
@@ -341,17 +353,54 @@ TEST_CASE("the kernels' samplers draw texels with the stored probabilities, neve
           if (p[t] == 0) CHECK(exact[t] == 0);
 
         // Statistically, through the kernels' functions and random numbers.
-        kern::EnvmapView view = viewOf(tables);
-        const uint64_t samples = 1000000;
-        std::vector<uint64_t> counts(p.size(), 0);
-        for (uint64_t i = 0; i < samples; ++i)
-          ++counts[sampledTexel(view, kern::philoxDraw(0x5eed, cdf ? 1 : 0, 0, 0, uint32_t(i)))];
-        uint64_t zeroWeightDraws = 0;
-        for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
-        CHECK(zeroWeightDraws == 0);
-        ChiSquare test = misalloc::test::chiSquare(counts, p, samples);
-        INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
-        if (test.degreesOfFreedom > 0) CHECK(test.pValue() > level);
+        checkDrawnTexels(viewOf(tables), p, 1000000, 0x5eed, cdf ? 1 : 0, level);
+      }
+    }
+}
+
+TEST_CASE("the optimal pdf's bank draws texels with the probabilities it evaluates, which integrate to 1",
+          "[envmap][optimal]") {
+  // [Kar19] eq. 9 per BRDF bin and envmap share (host/scene/OptimalBank.h): a block by
+  // the entry's table, then a texel of the block by the plain weights. The first and the
+  // last entry of each map and sampler; a false alarm in any χ² test with probability 2 %.
+  const misalloc::BrdfGrid grid = misalloc::makeBrdfGrid("seed000", 8, 8);
+  const std::array<float, 3> mirror = {-0.5f, 0.0f, 0.8660254f};  // a view 30° off the normal
+  const double level = misalloc::test::sidakLevel(0.02, int(2 * 2 * testMaps().size()));
+  for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
+    for (const auto& [name, map] : testMaps()) {
+      EnvmapTables tables = misalloc::buildOptimalEnvmapTables(map, sampler, grid, mirror);
+      INFO(name << (sampler == EnvmapSampler::Cdf ? ", CDF" : ", alias"));
+      CHECK(tables.requestedPdf.optimal());
+      if (name == "all black") {
+        CHECK_FALSE(tables.hasBank());  // falls back to the plain (uniform) tables
+        continue;
+      }
+      REQUIRE(tables.hasBank());
+      CHECK(tables.brdfBins > 1);
+      kern::EnvmapView view = viewOf(tables);
+      for (int entry : {0, tables.brdfBins * tables.bankShares - 1}) {
+        INFO("entry " << entry);
+        view.bankEntry = entry;
+        std::vector<double> p(std::size_t(tables.width) * tables.height);
+        double sum = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) sum += p[t] = kern::texelProbability(view, int(t));
+        // A block's and a texel's probability, each rounded to float, and their product.
+        CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
+
+        checkDrawnTexels(view, p, 200000, 0x0b7, uint32_t(entry), level);
+
+        // The pdf a BRDF-sampled direction reads, by the midpoint rule (as for the plain pdf).
+        const int k = p.size() > 100000 ? 1 : 4;
+        const int nu = k * tables.width, nv = k * tables.height;
+        double integral = 0;
+        for (int j = 0; j < nv; ++j) {
+          double v = (j + 0.5) / nv;
+          double rowWeight = 2 * kPi * kPi * std::sin(kPi * v) / (double(nu) * nv);
+          for (int i = 0; i < nu; ++i)
+            integral +=
+                kern::envmapLookup(view, kern::latLongDirection(float((i + 0.5) / nu), float(v))).pdf * rowWeight;
+        }
+        CHECK(std::abs(integral - 1) <= 32 * kFloatRounding);
       }
     }
 }

@@ -131,7 +131,7 @@ Subcommand addCompareCommand(CLI::App& app) {
   command->add_option("--methods", args->methods, "comma-separated methods, or all")->capture_default_str();
   command->add_option("--budgets", args->budgets, "samples per pixel, ascending")->capture_default_str();
   command
-      ->add_option("--envmap-pdfs", args->envmapPdfs, "envmap pdfs, each scene runs with each: plain, compensated[:C]")
+      ->add_option("--envmap-pdfs", args->envmapPdfs, "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal")
       ->capture_default_str();
   command->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
       ->capture_default_str()

@@ -33,8 +33,8 @@ void SceneArgs::add(CLI::App& command) {
 void SceneArgs::addEnvmapPdf(CLI::App& command) {
   command
       .add_option("--envmap-pdf", envmapPdf,
-                  "plain (∝ luminance) or compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C "
-                  "default 0.5)")
+                  "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C "
+                  "default 0.5) or optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables)")
       ->capture_default_str();
 }
 
@@ -67,6 +67,9 @@ Scene SceneArgs::make() {
         "misalloc: warning: envmap '{}': no texel exceeds 2(1-C) times the mean luminance; "
         "--envmap-pdf {} falls back to plain\n",
         options.envmap, envmapPdfName(scene.tables.requestedPdf));
+  if (scene.tables.requestedPdf.optimal() && !scene.tables.hasBank())
+    std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: --envmap-pdf optimal falls back to plain\n",
+                             options.envmap);
   return scene;
 }
 

@@ -14,6 +14,7 @@ std::string caseLabel(const SceneOptions& scene) {
   if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";
   if (scene.splitBrdf) name += "-split";
   if (scene.envmapPdf.compensated()) name += "-comp" + envmapPdfName(scene.envmapPdf).substr(sizeof("compensated"));
+  if (scene.envmapPdf.optimal()) name += "-optimal";
   return name;
 }
 

@@ -53,15 +53,6 @@ double brdfShape(FlatlandBrdf brdf, double t) {
   return brdf == FlatlandBrdf::Diffuse ? cosPlus(t) : std::pow(cosPlus(t - kPi / 8), 20) * cosPlus(t);
 }
 
-// [Kar19] eq. 5 clamped as in eq. 6, before normalisation: the free pdf that makes
-// c p + q ∝ f where it can.
-double misCompensated(double f, double q, double F, double c) { return std::max(0.0, f / (c * F) - q / c); }
-
-// [Kar19] eq. 9: the optimal free pdf for the Lagrange multiplier λ.
-double optimalFree(double f, double q, double lambda, double c) {
-  return std::max(0.0, f / std::sqrt(c * lambda) - q / c);
-}
-
 }  // namespace
 
 std::vector<double> flatlandMapA() {
@@ -98,18 +89,12 @@ FlatlandStudy::FlatlandStudy(FlatlandBrdf brdf, double envmapFraction) : c_(envm
     integral_ += weight_[n] * radiance_[n] * brdfPdf_[n];
   }
 
-  // ∫ p* dt falls as λ grows; eq. 10 brackets the λ where it is 1.
-  const double F2 = integral_ * integral_;
-  lambda_ = {0, c_ * F2, F2 / c_};
-  double lo = lambda_.lower, hi = lambda_.upper;
-  for (int iteration = 0; iteration < 100; ++iteration) {
-    const double mid = 0.5 * (lo + hi);
-    double mass = 0;
-    for (size_t n = 0; n < t_.size(); ++n)
-      mass += weight_[n] * optimalFree(radiance_[n] * brdfPdf_[n], (1 - c_) * brdfPdf_[n], mid, c_);
-    (mass > 1 ? lo : hi) = mid;
+  std::vector<double> f(t_.size()), q(t_.size());
+  for (size_t n = 0; n < t_.size(); ++n) {
+    f[n] = radiance_[n] * brdfPdf_[n];
+    q[n] = (1 - c_) * brdfPdf_[n];
   }
-  lambda_.lambda = 0.5 * (lo + hi);
+  lambda_ = solveOptimalLambda(f.data(), q.data(), weight_.data(), t_.size(), integral_, c_);
 }
 
 std::vector<double> FlatlandStudy::pdfAtNodes(FlatlandPdf pdf) const {

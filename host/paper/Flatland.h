@@ -11,6 +11,8 @@
 // 0.5; each bin holds the average over it.
 #include <vector>
 
+#include "scene/CompensatedPdf.h"
+
 namespace misalloc {
 
 enum class FlatlandBrdf {
@@ -32,11 +34,6 @@ struct FlatlandVariance {
   double multiSample = 0;  // of multi-sample MIS with one sample of each technique per unit
 };
 
-// The Lagrange multiplier of [Kar19] eq. 9 and its bounds c F² ≤ λ ≤ F²/c (eq. 10).
-struct FlatlandLambda {
-  double lambda = 0, lower = 0, upper = 0;
-};
-
 class FlatlandStudy {
  public:
   explicit FlatlandStudy(FlatlandBrdf brdf, double envmapFraction = 0.5);
@@ -47,7 +44,7 @@ class FlatlandStudy {
   // One technique alone, one-sample NMSE: the original HDR-map pdf, or the BRDF's.
   double hdrOnly() const;
   double brdfOnly() const;
-  const FlatlandLambda& lambda() const { return lambda_; }
+  const OptimalLambda& lambda() const { return lambda_; }
   // ∫ (p_compensated − p_optimal)² / ∫ p_optimal²: how far eq. 6 is from eq. 9.
   double compensatedVsOptimal() const;
 
@@ -61,7 +58,7 @@ class FlatlandStudy {
   std::vector<double> t_, weight_, radiance_, brdfPdf_;  // per node: angle, quadrature weight, L of its bin, p_ρ
   std::vector<double> bins_;                             // the map's bin averages
   double integral_ = 0;
-  FlatlandLambda lambda_;
+  OptimalLambda lambda_;
 };
 
 // Map A's 256 bin averages, bin b covering [−π + 2πb/256, −π + 2π(b+1)/256).

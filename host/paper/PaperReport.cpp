@@ -195,7 +195,7 @@ Values values001Flatland() {
   auto gain = [](const FlatlandStudy& s, FlatlandPdf pdf) {
     return s.variance(FlatlandPdf::Original).oneSample / s.variance(pdf).oneSample;
   };
-  auto withinBounds = [](const FlatlandLambda& l) { return l.lower <= l.lambda && l.lambda <= l.upper; };
+  auto withinBounds = [](const OptimalLambda& l) { return l.lower <= l.lambda && l.lambda <= l.upper; };
   Values v;
   v["diffuse, one-sample: NMSE(HDR only) / NMSE(MIS)"] =
       number(diffuse.hdrOnly() / diffuse.variance(FlatlandPdf::Original).oneSample);

@@ -10,13 +10,13 @@ namespace misalloc {
 
 void requireBrdfCoverage(const EnvmapPdf& envmapPdf, int techniqueCount, Method method, Estimator estimator, int spp,
                          const AdaptiveOptions& options) {
-  if (!envmapPdf.compensated()) return;
+  if (envmapPdf.plain()) return;
   const std::string pdf = envmapPdfName(envmapPdf);
   if (method == Method::Envmap)
     throw InputError(fmt::format(
-        "--method envmap with --envmap-pdf {}: the compensated pdf is zero where the radiance is at or below "
-        "2(1-C) times its mean, so envmap sampling alone would be biased; use --envmap-pdf plain, or a method "
-        "that also samples the BRDF",
+        "--method envmap with --envmap-pdf {}: the pdf is zero where BRDF sampling alone covers the integrand "
+        "(compensated: where the radiance is at or below 2(1-C) times its mean), so envmap sampling alone would "
+        "be biased; use --envmap-pdf plain, or a method that also samples the BRDF",
         pdf));
   const int M = techniqueCount;
   int smallest = spp;
@@ -29,7 +29,7 @@ void requireBrdfCoverage(const EnvmapPdf& envmapPdf, int techniqueCount, Method 
   if (smallest < M)
     throw InputError(fmt::format(
         "--spp {} with --method {} and --envmap-pdf {}: a stage of {} sample(s) cannot give each of the {} "
-        "techniques one, and the compensated pdf needs a BRDF sample in every stage; raise --spp or lower --stages",
+        "techniques one, and a compensated pdf needs a BRDF sample in every stage; raise --spp or lower --stages",
         spp, methodName(method), pdf, smallest, M));
 }
 

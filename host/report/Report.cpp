@@ -32,6 +32,24 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
       pdf["fallback_reason"] = "no texel's luminance exceeds 2(1-C) times the mean (a constant map?)";
     pdf["zero_texel_fraction"] = tables.zeroTexelFraction;
   }
+  if (tables.requestedPdf.optimal()) {
+    pdf["fallback_to_plain"] = !tables.hasBank();
+    if (!tables.hasBank()) pdf["fallback_reason"] = "the map is black";
+  }
+  if (tables.hasBank()) {
+    const BankVariances& v = tables.bankVariances;
+    const std::size_t entries = std::size_t(tables.brdfBins) * tables.bankShares;
+    pdf["bank"] = {{"brdf_bins", tables.brdfBins},
+                   {"envmap_shares", tables.bankShares},
+                   {"entries", entries},
+                   {"block_texels", 1 << (2 * tables.blockLog2)},
+                   // The sampling tables beside the texels: a plain alias table holds 8 B per texel.
+                   {"table_bytes", (tables.aliasTable.size() + tables.cdfTable.size() + tables.blockProbs.size()) * 4},
+                   {"build_seconds", tables.bankBuildSeconds},
+                   {"one_sample_variance_eq6_over_eq9_max", v.compensatedOverOptimalMax},
+                   {"one_sample_variance_eq6_over_eq9_mean", v.compensatedOverOptimalMean},
+                   {"entries_with_negative_eq5", v.entriesWithNegativeEq5}};
+  }
   return pdf;
 }
 

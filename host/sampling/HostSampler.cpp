@@ -20,6 +20,11 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   env.cdfStepsRow = t.cdfStepsRow;
   env.cdfStepsCol = t.cdfStepsCol;
   env.coskExponent = coskExponent;
+  env.bankShares = t.bankShares;
+  env.blockLog2 = t.blockLog2;
+  env.blockProbs = t.blockProbs.data();
+  env.brdfBin = 0;
+  env.bankEntry = 0;
   return env;
 }
 
@@ -53,6 +58,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   auto start = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(dynamic, 64)
   for (int pixel = range.begin; pixel < range.end; ++pixel) {
+    kern::EnvmapView pixelEnv = env;
+    if (scene_.tables.hasBank()) pixelEnv.brdfBin = scene_.tables.brdfBinOfPixel[pixel];
     const PhongParameters& p = scene_.grid.pixels[pixel];
     kern::PhongParams b;
     b.rhoD = p.rhoD;
@@ -65,7 +72,7 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {
       kern::SampleContribution s =
-          kern::takeStageSample(ts, env, b, c, j, uint32_t(seed), uint32_t(seed >> 32), uint32_t(pixel));
+          kern::takeStageSample(ts, pixelEnv, b, c, j, uint32_t(seed), uint32_t(seed >> 32), uint32_t(pixel));
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)
         if (s.technique == slot / perTechnique)

@@ -38,10 +38,10 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
   const EnvmapTables& t = scene.tables;
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
-      "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_STATS={} "
-      "-DMA_STORE_SAMPLES={} -DMA_LOCAL_SIZE={}",
+      "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
+      "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_STATS={} -DMA_STORE_SAMPLES={} -DMA_LOCAL_SIZE={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
-      scene.envmap.coskExponent, config.estimator == Estimator::OneSample ? 1 : 0,
+      scene.envmap.coskExponent, t.bankShares, t.blockLog2, config.estimator == Estimator::OneSample ? 1 : 0,
       config.estimator == Estimator::CountIndependent ? 1 : 0, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
       localSize);
 }
@@ -51,9 +51,13 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
   texels = upload(device, t.texels);
   cdfTable = upload(device, t.cdfTable);
   aliasTable = upload(device, t.aliasTable);
+  blockProbs = upload(device, t.blockProbs);
   std::vector<float> params;
   params.reserve(scene.grid.pixels.size() * 4);
-  for (const auto& p : scene.grid.pixels) params.insert(params.end(), {p.rhoD, p.rhoS, p.n, 0.0f});
+  for (std::size_t p = 0; p < scene.grid.pixels.size(); ++p) {
+    const PhongParameters& b = scene.grid.pixels[p];
+    params.insert(params.end(), {b.rhoD, b.rhoS, b.n, t.hasBank() ? float(t.brdfBinOfPixel[p]) : 0.0f});
+  }
   brdfParams = upload(device, params);
 }
 
@@ -149,10 +153,11 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
-  bindKernelArgs(kernel, b.texels, b.cdfTable, b.aliasTable, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
-                 b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
-                 cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(range.size()),
-                 pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity));
+  bindKernelArgs(kernel, b.texels, b.cdfTable, b.aliasTable, b.blockProbs, cl_int(scene_.tables.width),
+                 cl_int(scene_.tables.height), b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2],
+                 counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
+                 cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
+                 cl_int(config_.sampleCapacity));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);

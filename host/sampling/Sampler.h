@@ -22,7 +22,7 @@ class SceneBuffers {
   SceneBuffers(const Device& device, const Scene& scene);
   cl_context context() const { return context_; }
 
-  cl::Buffer texels, cdfTable, aliasTable, brdfParams;
+  cl::Buffer texels, cdfTable, aliasTable, blockProbs, brdfParams;
 
  private:
   cl_context context_;

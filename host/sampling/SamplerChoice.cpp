@@ -50,9 +50,9 @@ DeviceError explain(const cl::Error& e, const Device& device, const Scene& scene
 void requireTablesFit(const Device& device, const Scene& scene) {
   const EnvmapTables& t = scene.tables;
   const uint64_t sizes[] = {t.texels.size() * sizeof(float), t.cdfTable.size() * sizeof(float),
-                            t.aliasTable.size() * sizeof(uint32_t)};
+                            t.aliasTable.size() * sizeof(uint32_t), t.blockProbs.size() * sizeof(float)};
   const uint64_t largest = *std::max_element(std::begin(sizes), std::end(sizes));
-  const uint64_t total = sizes[0] + sizes[1] + sizes[2];
+  const uint64_t total = sizes[0] + sizes[1] + sizes[2] + sizes[3];
   const uint64_t maxAlloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   const uint64_t global = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   if (largest > maxAlloc || total > global)

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -12,6 +13,7 @@ namespace misalloc {
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
   const std::string compensated = "compensated";
   if (spec == "plain") return {};
+  if (spec == "optimal") return {EnvmapPdf::Kind::Optimal, 0.5};
   if (spec == compensated) return {EnvmapPdf::Kind::Compensated, 0.5};
   if (spec.rfind(compensated + ":", 0) == 0) {
     const char* first = spec.data() + compensated.size() + 1;
@@ -22,11 +24,19 @@ EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
     throw InputError(
         fmt::format("{} {}: C, the envmap technique's share of the samples, must lie in (0, 1]", option, spec));
   }
-  throw InputError(fmt::format("{} '{}': expected plain, compensated or compensated:C", option, spec));
+  throw InputError(fmt::format("{} '{}': expected plain, compensated, compensated:C or optimal", option, spec));
 }
 
 std::string envmapPdfName(const EnvmapPdf& pdf) {
-  return pdf.compensated() ? fmt::format("compensated:{:g}", pdf.envmapFraction) : "plain";
+  switch (pdf.kind) {
+    case EnvmapPdf::Kind::Compensated:
+      return fmt::format("compensated:{:g}", pdf.envmapFraction);
+    case EnvmapPdf::Kind::Optimal:
+      return "optimal";
+    case EnvmapPdf::Kind::Plain:
+      break;
+  }
+  return "plain";
 }
 
 double solidAngleMeanLuminance(const std::vector<double>& luminance, int width, int height) {
@@ -44,6 +54,37 @@ double compensatedLuminance(double luminance, double meanLuminance, double envma
   const double threshold = 2 * (1 - envmapFraction) * meanLuminance;  // [Kar19] eq. 14
   const double excess = luminance - threshold;
   return excess > 1e-6 * threshold ? excess : 0.0;
+}
+
+double misCompensated(double f, double q, double F, double c) { return std::max(0.0, f / (c * F) - q / c); }
+
+namespace {
+
+// [Kar19] eq. 9 with 1/√(cλ) and q/c given, so that λ's bisection computes them once.
+double optimalFreeScaled(double f, double qOverC, double inverseRoot) {
+  return std::max(0.0, f * inverseRoot - qOverC);
+}
+
+}  // namespace
+
+double optimalFree(double f, double q, double lambda, double c) {
+  return optimalFreeScaled(f, q / c, 1 / std::sqrt(c * lambda));
+}
+
+OptimalLambda solveOptimalLambda(const double* f, const double* q, const double* w, std::size_t n, double F, double c) {
+  OptimalLambda bracket{0, c * F * F, F * F / c};
+  std::vector<double> qOverC(q, q + n);
+  for (double& v : qOverC) v /= c;
+  double lo = bracket.lower, hi = bracket.upper;
+  // λ to 12 digits: far below what a tabulated pdf resolves.
+  while (hi - lo > 1e-12 * hi) {
+    const double mid = 0.5 * (lo + hi), inverseRoot = 1 / std::sqrt(c * mid);
+    double mass = 0;
+    for (std::size_t i = 0; i < n; ++i) mass += w[i] * optimalFreeScaled(f[i], qOverC[i], inverseRoot);
+    (mass > 1 ? lo : hi) = mid;
+  }
+  bracket.lambda = 0.5 * (lo + hi);
+  return bracket;
 }
 
 }  // namespace misalloc

@@ -2,27 +2,34 @@
 // MIS compensation [Kar19]: when envmap sampling is combined with BRDF sampling by
 // MIS, the envmap pdf should cover what BRDF sampling leaves uncovered, not the whole
 // radiance. The practical, normal-independent form ([Kar19] eq. 14) subtracts a
-// constant from the luminance before tabulating it.
+// constant from the luminance before tabulating it. The general forms (eqs. 5–10) are
+// here too: host/scene/OptimalBank.h tabulates them per BRDF, host/paper/Flatland.h
+// reproduces the paper's 1D test with them.
+#include <cstddef>
 #include <string>
 #include <vector>
 
 namespace misalloc {
 
 // The shape of the envmap technique's pdf (`--envmap-pdf`).
+// `Optimal` is [Kar19] eq. 9 for each pixel's own BRDF and envmap share (a bank of
+// tables, host/scene/OptimalBank.h).
 struct EnvmapPdf {
-  enum class Kind { Plain, Compensated };
+  enum class Kind { Plain, Compensated, Optimal };
   Kind kind = Kind::Plain;
   // C of [Kar19] eq. 14: the envmap technique's share of the samples, in (0, 1].
   double envmapFraction = 0.5;
 
+  bool plain() const { return kind == Kind::Plain; }
   bool compensated() const { return kind == Kind::Compensated; }
+  bool optimal() const { return kind == Kind::Optimal; }
 };
 
-// "plain", "compensated" or "compensated:C" with 0 < C ≤ 1; throws InputError,
-// naming `option`, otherwise.
+// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, or "optimal"; throws
+// InputError, naming `option`, otherwise.
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option = "--envmap-pdf");
 
-// "plain" or "compensated:C", which parseEnvmapPdf reads back.
+// "plain", "compensated:C" or "optimal", which parseEnvmapPdf reads back.
 std::string envmapPdfName(const EnvmapPdf& pdf);
 
 // L̄ of [Kar19] eq. 14: the luminance of a W×H lat-long map (row-major, row 0 at the
@@ -35,5 +42,20 @@ double solidAngleMeanLuminance(const std::vector<double>& luminance, int width, 
 // double; a difference within 1e-6 of the threshold is rounding of L̄'s sum over the
 // texels (a constant map at C = 0.5), not radiance, and counts as 0.
 double compensatedLuminance(double luminance, double meanLuminance, double envmapFraction);
+
+// [Kar19] eq. 5 clamped as in eq. 6, before normalisation: the free pdf p that makes
+// c p + q ∝ f where it can. q = Σ of the other techniques' fractions × pdfs.
+double misCompensated(double f, double q, double F, double c);
+
+// [Kar19] eq. 9: the optimal free pdf for the Lagrange multiplier λ.
+double optimalFree(double f, double q, double lambda, double c);
+
+struct OptimalLambda {
+  double lambda = 0, lower = 0, upper = 0;  // eq. 10: c F² ≤ λ ≤ F²/c
+};
+
+// The λ of eq. 9 that makes Σ_i w_i p*(x_i) = 1, by bisection within eq. 10's bounds
+// (∫ p* falls as λ grows). f_i, q_i are densities at nodes of weight w_i, F = Σ w_i f_i.
+OptimalLambda solveOptimalLambda(const double* f, const double* q, const double* w, std::size_t n, double F, double c);
 
 }  // namespace misalloc

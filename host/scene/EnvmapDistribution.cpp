@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -99,14 +100,15 @@ double drawnShare(const float* cdf, int i) {
   return (std::ceil(double(cdf[i + 1]) * grid) - std::ceil(double(cdf[i]) * grid)) / grid;
 }
 
-// The probability of each texel under the CDF sampler, exactly as drawn.
-void storeDrawnProbabilities(const std::vector<float>& cdf, int width, int height, std::vector<float>& texels) {
-  const float* marginal = cdf.data();
+// The probability of each cell under the CDF sampler, exactly as drawn, at
+// out[stride · cell].
+void storeDrawnProbabilities(const float* cdf, int width, int height, float* out, std::size_t stride) {
+  const float* marginal = cdf;
   for (int row = 0; row < height; ++row) {
     double rowShare = drawnShare(marginal, row);
     const float* conditional = marginal + (height + 1) + std::size_t(row) * std::size_t(width + 1);
     for (int col = 0; col < width; ++col)
-      texels[4 * (std::size_t(row) * width + col) + 3] = float(rowShare * drawnShare(conditional, col));
+      out[stride * (std::size_t(row) * width + col)] = float(rowShare * drawnShare(conditional, col));
   }
 }
 
@@ -125,6 +127,32 @@ int binarySearchSteps(int n) {
   int steps = 0;
   while ((int64_t(1) << steps) < n) ++steps;
   return steps;
+}
+
+// Each block's alias table over its 2^L × 2^L slots (row-major in the block), ∝ the
+// texels' weights, at table[2 · (block · 4^L + slot)]; slots past the map's edge weigh
+// 0. A block of no weight is never drawn; its table is uniform over its texels so that
+// it stays valid.
+void writeBlockSlotTables(const std::vector<double>& weights, int width, int height, int blockLog2, uint32_t* table) {
+  const int side = 1 << blockLog2, slotCount = side * side;
+  const int across = (width + side - 1) / side, down = (height + side - 1) / side;
+#pragma omp parallel for schedule(static)
+  for (int blockRow = 0; blockRow < down; ++blockRow) {
+    std::vector<double> slots(slotCount);
+    for (int blockCol = 0; blockCol < across; ++blockCol) {
+      auto inside = [&](int s) { return blockRow * side + s / side < height && blockCol * side + s % side < width; };
+      double total = 0;
+      for (int s = 0; s < slotCount; ++s) {
+        slots[s] =
+            inside(s) ? weights[std::size_t(blockRow * side + s / side) * width + blockCol * side + s % side] : 0;
+        total += slots[s];
+      }
+      if (!(total > 0))
+        for (int s = 0; s < slotCount; ++s) slots[s] = inside(s) ? 1.0 : 0.0;
+      const std::vector<uint32_t> block = interleave(buildAliasTable(slots));
+      std::copy(block.begin(), block.end(), table + 2 * (std::size_t(blockRow) * across + blockCol) * slotCount);
+    }
+  }
 }
 
 }  // namespace
@@ -175,11 +203,86 @@ EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, cons
     tables.aliasTable = {0};
     tables.cdfStepsRow = binarySearchSteps(image.height);
     tables.cdfStepsCol = binarySearchSteps(image.width);
-    storeDrawnProbabilities(tables.cdfTable, image.width, image.height, tables.texels);
+    storeDrawnProbabilities(tables.cdfTable.data(), image.width, image.height, tables.texels.data() + 3, 4);
   } else {
     tables.cdfTable = {0};
     tables.aliasTable = interleave(buildAliasTable(std::move(weights)));
   }
+  return tables;
+}
+
+EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
+                                      const std::array<float, 3>& mirror, const OptimalBankOptions& options) {
+  requireValidSize(envmap);
+  const RgbImage& image = envmap.image;
+  const int width = image.width, height = image.height;
+  const std::vector<double> luminance = texelLuminance(image);
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<double> weights = sinThetaWeighted(luminance, width, height);
+  double total = 0;
+  for (double w : weights) total += w;
+  if (!(total > 0)) {
+    EnvmapTables plain = buildEnvmapTables(envmap, sampler);
+    plain.requestedPdf = {EnvmapPdf::Kind::Optimal};
+    return plain;
+  }
+
+  EnvmapTables tables;
+  tables.width = width;
+  tables.height = height;
+  tables.requestedPdf = tables.pdf = {EnvmapPdf::Kind::Optimal};
+  tables.meanLuminance = solidAngleMeanLuminance(luminance, width, height);
+  tables.bankShares = options.shares;
+  tables.blockLog2 = options.blockLog2;
+  const BrdfBins bins = binBrdfs(grid, options.exponentBins, options.diffuseBins);
+  tables.brdfBins = int(bins.centres.size());
+  tables.brdfBinOfPixel = bins.binOfPixel;
+  OptimalBankWeights bank = optimalBlockWeights(weights, width, height, bins, mirror, options);
+  tables.bankVariances = bank.variances;
+
+  // Texels: RGB and the probability within the block.
+  const int side = 1 << options.blockLog2;
+  const int across = (width + side - 1) / side, down = (height + side - 1) / side;
+  auto blockOf = [&](std::size_t t) { return (t / width / side) * across + (t % width) / side; };
+  std::vector<double> blockMass(std::size_t(across) * down, 0.0);
+  for (std::size_t t = 0; t < weights.size(); ++t) blockMass[blockOf(t)] += weights[t];
+  tables.texels.resize(weights.size() * 4);
+  for (std::size_t t = 0; t < weights.size(); ++t) {
+    for (int c = 0; c < 3; ++c) tables.texels[4 * t + c] = image.rgb[3 * t + c];
+    const double mass = blockMass[blockOf(t)];
+    tables.texels[4 * t + 3] = float(mass > 0 ? weights[t] / mass : 0.0);
+  }
+
+  tables.useCdf = sampler == EnvmapSampler::Cdf;
+  const std::size_t blocks = blockMass.size(), slotWords = 2 * blocks * side * side;
+  const std::size_t cdfSize = std::size_t(down + 1) + std::size_t(down) * (across + 1);
+  const std::size_t entries = bank.entries.size();
+  tables.aliasTable.assign(slotWords + (tables.useCdf ? 0 : 2 * entries * blocks), 0u);
+  writeBlockSlotTables(weights, width, height, options.blockLog2, tables.aliasTable.data());
+  tables.blockProbs.assign(entries * blocks, 0.0f);
+  if (tables.useCdf) {
+    tables.cdfTable.assign(entries * cdfSize, 0.0f);
+    tables.cdfStepsRow = binarySearchSteps(down);
+    tables.cdfStepsCol = binarySearchSteps(across);
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t e = 0; e < entries; ++e) {
+    std::vector<double>& entry = bank.entries[e];
+    float* probs = tables.blockProbs.data() + e * blocks;
+    if (tables.useCdf) {
+      const std::vector<float> cdf = cdfTables(entry, across, down);
+      storeDrawnProbabilities(cdf.data(), across, down, probs, 1);
+      std::copy(cdf.begin(), cdf.end(), tables.cdfTable.begin() + std::ptrdiff_t(e * cdfSize));
+    } else {
+      double entryTotal = 0;
+      for (double w : entry) entryTotal += w;
+      for (std::size_t k = 0; k < blocks; ++k) probs[k] = float(entry[k] / entryTotal);
+      const std::vector<uint32_t> alias = interleave(buildAliasTable(std::move(entry)));
+      std::copy(alias.begin(), alias.end(), tables.aliasTable.begin() + std::ptrdiff_t(slotWords + 2 * e * blocks));
+    }
+  }
+  if (!tables.useCdf) tables.cdfTable = {0};
+  tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return tables;
 }
 

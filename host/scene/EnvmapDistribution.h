@@ -2,12 +2,16 @@
 // The envmap's sampling distribution, laid out as kernels/envmap.h reads it: texel
 // probabilities ∝ luminance × sin θ (or its MIS-compensated form, [Kar19] eq. 14, ×
 // sin θ), and either an alias table or marginal and conditional CDFs that draw texels
-// with those probabilities.
+// with those probabilities; or, for the optimal pdf ([Kar19] eq. 9), a bank of such
+// tables over blocks of texels (host/scene/OptimalBank.h).
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "scene/BrdfGrid.h"
 #include "scene/CompensatedPdf.h"
 #include "scene/Envmap.h"
+#include "scene/OptimalBank.h"
 
 namespace misalloc {
 
@@ -36,6 +40,17 @@ struct EnvmapTables {
   EnvmapPdf requestedPdf, pdf;
   double meanLuminance = 0;      // L̄ of [Kar19] eq. 14 (solidAngleMeanLuminance)
   double zeroTexelFraction = 0;  // compensated: the texels it never draws (L ≤ 2(1−C)·L̄)
+
+  // The optimal pdf's bank, laid out as kernels/envmap.h's EnvmapView describes; none
+  // while bankShares = 0. Then texels[4t + 3] is t's probability within its block.
+  int bankShares = 0, blockLog2 = 0;
+  int brdfBins = 0;
+  std::vector<float> blockProbs{0};  // per entry, per block (never empty: an OpenCL buffer)
+  std::vector<int> brdfBinOfPixel;   // the kernels read it as the 4th float of the pixel's BRDF
+  BankVariances bankVariances;
+  double bankBuildSeconds = 0;  // building every table from the map's luminance
+
+  bool hasBank() const { return bankShares > 0; }
 };
 
 // Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B (compensated with
@@ -48,5 +63,11 @@ struct EnvmapTables {
 // makeEnvmap make them (else std::invalid_argument). Throws InputError, naming the
 // map, if it has too many texels for the kernels' 32-bit int indexing.
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf = {});
+
+// The optimal pdf for the grid's BRDFs seen from `mirror`: the bank of block tables
+// (alias or CDF, as `sampler`), each block's texels drawn by alias tables ∝ luminance ×
+// sin θ. A black map falls back to plain (uniform) tables.
+EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
+                                      const std::array<float, 3>& mirror, const OptimalBankOptions& options = {});
 
 }  // namespace misalloc

@@ -135,8 +135,7 @@ std::string encode(const Imf::Header& header, const Imf::FrameBuffer& frame) {
 void requireFinite(const float* values, std::size_t count, const std::string& what) {
   std::size_t bad = 0;
   for (std::size_t i = 0; i < count; ++i) bad += std::isfinite(values[i]) ? 0 : 1;
-  if (bad > 0)
-    throw std::runtime_error(fmt::format("{} holds {} NaN or infinite values; not written", what, bad));
+  if (bad > 0) throw std::runtime_error(fmt::format("{} holds {} NaN or infinite values; not written", what, bad));
 }
 
 Imf::Header floatHeader(int width, int height, const std::vector<std::string>& names) {

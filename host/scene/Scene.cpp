@@ -71,19 +71,29 @@ Scene makeScene(const SceneOptions& options) {
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
-  scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
-  // The tables hold every texel's RGB beside its probability (kernels/envmap.h), so the
-  // input copy goes: 12 of the map's bytes per texel. A compensated pdf keeps it for the
-  // plain tables of the reference and the costs (withPlainEnvmapPdf).
-  if (!options.envmapPdf.compensated()) scene.envmap.image.rgb = std::vector<float>();
   double t = options.viewTheta * M_PI / 180, p = options.viewPhi * M_PI / 180;
   // ω_r = 2(n·ω_o)n − ω_o with n = z.
   scene.mirror = {float(-std::sin(t) * std::cos(p)), float(-std::sin(t) * std::sin(p)), float(std::cos(t))};
+  if (options.envmapPdf.optimal()) {
+    // q = (1−C) p_ρ of [Kar19] eq. 9 takes the BRDF as one technique; split into lobes,
+    // q would depend on the lobes' shares too.
+    if (options.splitBrdf)
+      throw InputError(
+          "--envmap-pdf optimal with --split-brdf: not implemented; the optimal pdf's bank is built "
+          "for the BRDF as one technique (M = 2)");
+    scene.tables = buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
+  } else {
+    scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
+  }
+  // The tables hold every texel's RGB beside its probability (kernels/envmap.h), so the
+  // input copy goes: 12 of the map's bytes per texel. Any other pdf than plain keeps it
+  // for the plain tables of the reference and the costs (withPlainEnvmapPdf).
+  if (options.envmapPdf.plain()) scene.envmap.image.rgb = std::vector<float>();
   return scene;
 }
 
 Scene withPlainEnvmapPdf(const Scene& scene) {
-  if (!scene.options.envmapPdf.compensated()) return scene;
+  if (scene.options.envmapPdf.plain()) return scene;
   Scene plain = scene;
   plain.options.envmapPdf = {};
   plain.tables = buildEnvmapTables(plain.envmap, plain.options.sampler);

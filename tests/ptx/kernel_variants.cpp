@@ -47,8 +47,9 @@ struct Variant {
   bool operator<(const Variant& other) const { return std::tie(file, options) < std::tie(other.file, other.options); }
 };
 
-Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler) {
+Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler, const std::string& pdf) {
   SceneOptions o;
+  o.envmapPdf = parseEnvmapPdf(pdf);
   o.envmap = envmap;
   o.grid = "uniform:0.5,0.5,10";
   o.width = o.height = 4;
@@ -60,23 +61,26 @@ Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler) {
 
 // Every program a Sampler can build: per scene, each method's config (the fixed splits
 // with every estimator) and its plainConfig, at each work-group size, and the grid
-// search where the config asks for one (Sampler's constructor).
+// search where the config asks for one (Sampler's constructor). The optimal pdf's bank
+// (M = 2 only) on one map: the map changes MA_COSK alone.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
-  for (bool split : {false, true})
-    for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
-      for (const char* envmap : {"constant", "cosk:3"}) {
-        Scene s = scene(envmap, split, sampler);
-        for (Method method : allMethods())
-          for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent}) {
-            SamplerConfig config = samplerConfigFor(method, estimator, 64, AdaptiveOptions{});
-            for (int localSize : {8, 64, 128, 256}) {
-              variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
-              variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
+  for (const std::string pdf : {"plain", "optimal"})
+    for (bool split : {false, true})
+      for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
+        for (const std::string envmap : {"constant", "cosk:3"}) {
+          if (pdf == "optimal" && (split || envmap != "constant")) continue;
+          Scene s = scene(envmap, split, sampler, pdf);
+          for (Method method : allMethods())
+            for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent}) {
+              SamplerConfig config = samplerConfigFor(method, estimator, 64, AdaptiveOptions{});
+              for (int localSize : {8, 64, 128, 256}) {
+                variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
+                variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
+              }
+              if (config.gridSize > 0) variants.insert({"gridsearch.cl", gridSearchKernelOptions(s.techniqueCount())});
             }
-            if (config.gridSize > 0) variants.insert({"gridsearch.cl", gridSearchKernelOptions(s.techniqueCount())});
-          }
-      }
+        }
   return variants;
 }
 
