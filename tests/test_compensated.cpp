@@ -222,10 +222,13 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
   };
   const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
   const std::vector<std::pair<Method, Estimator>>& methods = kMethodsWithBrdfSampling;
+  // The CDF sampler draws the bank's blocks for the first case only: the blocks' texels
+  // and the entries are the alias sampler's.
   uint64_t seed = 1900;
   for (const Case& c : cases)
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
-      if (smallTestSize() && (&c != &cases[0] || s != EnvmapSampler::Alias)) {
+      if ((s == EnvmapSampler::Cdf && &c != &cases[0]) ||
+          (smallTestSize() && (&c != &cases[0] || s != EnvmapSampler::Alias))) {
         seed += methods.size();
         continue;
       }

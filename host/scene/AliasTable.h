@@ -20,4 +20,12 @@ struct AliasTable {
 // value: the table reuses the weights' memory, so callers with large maps move them in.
 AliasTable buildAliasTable(std::vector<double> weights);
 
+// The same for many small tables: weights[0, n) into probability[0, n) and alias[0, n),
+// with the working memory kept in `scratch` from one call to the next.
+struct AliasScratch {
+  std::vector<double> q;
+  std::vector<uint32_t> under, over;
+};
+void buildAliasTable(const double* weights, std::size_t n, float* probability, uint32_t* alias, AliasScratch& scratch);
+
 }  // namespace misalloc

@@ -136,22 +136,31 @@ int binarySearchSteps(int n) {
 void writeBlockSlotTables(const std::vector<double>& weights, int width, int height, int blockLog2, uint32_t* table) {
   const int side = 1 << blockLog2, slotCount = side * side;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
-#pragma omp parallel for schedule(static)
-  for (int blockRow = 0; blockRow < down; ++blockRow) {
+#pragma omp parallel
+  {
     std::vector<double> slots(slotCount);
-    for (int blockCol = 0; blockCol < across; ++blockCol) {
-      auto inside = [&](int s) { return blockRow * side + s / side < height && blockCol * side + s % side < width; };
-      double total = 0;
-      for (int s = 0; s < slotCount; ++s) {
-        slots[s] =
-            inside(s) ? weights[std::size_t(blockRow * side + s / side) * width + blockCol * side + s % side] : 0;
-        total += slots[s];
+    std::vector<float> probability(slotCount);
+    std::vector<uint32_t> alias(slotCount);
+    AliasScratch scratch;
+#pragma omp for schedule(static)
+    for (int blockRow = 0; blockRow < down; ++blockRow)
+      for (int blockCol = 0; blockCol < across; ++blockCol) {
+        auto inside = [&](int s) { return blockRow * side + s / side < height && blockCol * side + s % side < width; };
+        double total = 0;
+        for (int s = 0; s < slotCount; ++s) {
+          slots[s] =
+              inside(s) ? weights[std::size_t(blockRow * side + s / side) * width + blockCol * side + s % side] : 0;
+          total += slots[s];
+        }
+        if (!(total > 0))
+          for (int s = 0; s < slotCount; ++s) slots[s] = inside(s) ? 1.0 : 0.0;
+        buildAliasTable(slots.data(), slots.size(), probability.data(), alias.data(), scratch);
+        uint32_t* out = table + 2 * (std::size_t(blockRow) * across + blockCol) * slotCount;
+        for (int s = 0; s < slotCount; ++s) {
+          std::memcpy(&out[2 * s], &probability[s], sizeof(float));
+          out[2 * s + 1] = alias[s];
+        }
       }
-      if (!(total > 0))
-        for (int s = 0; s < slotCount; ++s) slots[s] = inside(s) ? 1.0 : 0.0;
-      const std::vector<uint32_t> block = interleave(buildAliasTable(slots));
-      std::copy(block.begin(), block.end(), table + 2 * (std::size_t(blockRow) * across + blockCol) * slotCount);
-    }
   }
 }
 
@@ -243,14 +252,21 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   // Texels: RGB and the probability within the block.
   const int side = 1 << options.blockLog2;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
-  auto blockOf = [&](std::size_t t) { return (t / width / side) * across + (t % width) / side; };
   std::vector<double> blockMass(std::size_t(across) * down, 0.0);
-  for (std::size_t t = 0; t < weights.size(); ++t) blockMass[blockOf(t)] += weights[t];
+  for (int row = 0; row < height; ++row) {
+    double* mass = blockMass.data() + std::size_t(row >> options.blockLog2) * across;
+    for (int col = 0; col < width; ++col) mass[col >> options.blockLog2] += weights[std::size_t(row) * width + col];
+  }
   tables.texels.resize(weights.size() * 4);
-  for (std::size_t t = 0; t < weights.size(); ++t) {
-    for (int c = 0; c < 3; ++c) tables.texels[4 * t + c] = image.rgb[3 * t + c];
-    const double mass = blockMass[blockOf(t)];
-    tables.texels[4 * t + 3] = float(mass > 0 ? weights[t] / mass : 0.0);
+#pragma omp parallel for schedule(static)
+  for (int row = 0; row < height; ++row) {
+    const double* mass = blockMass.data() + std::size_t(row >> options.blockLog2) * across;
+    for (int col = 0; col < width; ++col) {
+      const std::size_t t = std::size_t(row) * width + col;
+      for (int c = 0; c < 3; ++c) tables.texels[4 * t + c] = image.rgb[3 * t + c];
+      const double blockWeight = mass[col >> options.blockLog2];
+      tables.texels[4 * t + 3] = float(blockWeight > 0 ? weights[t] / blockWeight : 0.0);
+    }
   }
 
   tables.useCdf = sampler == EnvmapSampler::Cdf;

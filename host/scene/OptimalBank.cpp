@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "KernelCode.h"
 #include "scene/CompensatedPdf.h"
@@ -57,18 +56,17 @@ BrdfBins binBrdfs(const BrdfGrid& grid, int exponentBins, int diffuseBins) {
     diffuse.push_back(albedo > 0 ? p.rhoD / albedo : 1.0);  // kernels/phong.h, diffuseLobeWeight
   }
   const Axis exponents(logN, exponentBins), diffuseWeights(diffuse, diffuseBins);
-  // Bins no pixel falls in get no table.
-  std::map<int, int> used;
+  // Bins no pixel falls in get no table; the others are numbered as pixels first fall in them.
+  std::vector<int> index(std::size_t(exponents.bins) * diffuseWeights.bins, -1);
   BrdfBins bins;
   for (std::size_t p = 0; p < logN.size(); ++p) {
     const int cell = exponents.binOf(logN[p]) * diffuseWeights.bins + diffuseWeights.binOf(diffuse[p]);
-    auto [it, inserted] = used.emplace(cell, int(used.size()));
-    bins.binOfPixel.push_back(it->second);
-  }
-  bins.centres.resize(used.size());
-  for (auto [cell, index] : used) {
-    const double wd = diffuseWeights.centre(cell % diffuseWeights.bins);
-    bins.centres[index] = {float(wd), float(1 - wd), float(std::exp(exponents.centre(cell / diffuseWeights.bins)))};
+    if (index[cell] < 0) {
+      index[cell] = int(bins.centres.size());
+      const double wd = diffuseWeights.centre(cell % diffuseWeights.bins);
+      bins.centres.push_back({float(wd), float(1 - wd), float(std::exp(exponents.centre(cell / diffuseWeights.bins)))});
+    }
+    bins.binOfPixel.push_back(index[cell]);
   }
   return bins;
 }
@@ -84,7 +82,7 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
   // f and p_ρ are taken at the centres of cells of 4 × 4 texels, each cell weighted by
   // its texels' plain weights and solid angles: 16 evaluations per 8 × 8 block, which
   // keeps the bank's build a few percent of a render's time.
-  const int cellSide = 1 << std::min(options.blockLog2, 2);
+  const int cellLog2 = std::min(options.blockLog2, 2), cellSide = 1 << cellLog2;
   const int cellsAcross = (width + cellSide - 1) / cellSide, cellsDown = (height + cellSide - 1) / cellSide;
   struct Cell {
     kern::MaVec3 direction;
@@ -95,11 +93,13 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
   std::vector<double> plainMass(blocks, 0.0);
   for (int row = 0; row < height; ++row) {
     const double sinTheta = std::sin(kPi * (row + 0.5) / height);
+    Cell* cellRow = cells.data() + std::size_t(row >> cellLog2) * cellsAcross;
+    double* massRow = plainMass.data() + std::size_t(row >> options.blockLog2) * across;
+    const double* weightRow = plainWeights.data() + std::size_t(row) * width;
     for (int col = 0; col < width; ++col) {
-      Cell& cell = cells[std::size_t(row / cellSide) * cellsAcross + col / cellSide];
-      cell.plain += plainWeights[std::size_t(row) * width + col];
-      cell.solidAngle += sinTheta;
-      plainMass[std::size_t(row / side) * across + col / side] += plainWeights[std::size_t(row) * width + col];
+      cellRow[col >> cellLog2].plain += weightRow[col];
+      cellRow[col >> cellLog2].solidAngle += sinTheta;
+      massRow[col >> options.blockLog2] += weightRow[col];
     }
   }
   for (int cellRow = 0; cellRow < cellsDown; ++cellRow)
