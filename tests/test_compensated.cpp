@@ -186,7 +186,6 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
     const char* pdf;
   };
   const Case cases[] = {{0.5, 5, 1, "compensated"}, {0.2, 50, 3, "compensated:0.25"}, {0.9, 20, 0.5, "compensated"}};
-  const std::vector<std::pair<Method, Estimator>>& methods = kMethodsWithBrdfSampling;
   uint64_t seed = 900;
   for (const Case& c : cases) {
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
@@ -195,13 +194,13 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
         // The small size (tests/TestSize.h) keeps the first case, unsplit, with the
         // alias sampler, under the seeds it has in the full sweep.
         if (smallTestSize() && (&c != &cases[0] || split || s != EnvmapSampler::Alias)) {
-          seed += methods.size();
+          seed += kMethodsWithBrdfSampling.size();
           continue;
         }
         Scene scene = compensatedScene(fmt::format("cosk:{}", c.K),
                                        fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), c.pdf, s, split);
         REQUIRE(scene.tables.pdf.compensated());
-        for (auto [m, e] : methods) {
+        for (auto [m, e] : kMethodsWithBrdfSampling) {
           Rendering r = renderWith(scene, m, e, 60, ++seed);
           MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
           double z = zScore(mean.mean, expected, mean.standardError);
@@ -221,7 +220,6 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
     double rhoD, n, K;
   };
   const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
-  const std::vector<std::pair<Method, Estimator>>& methods = kMethodsWithBrdfSampling;
   // The CDF sampler draws the bank's blocks for the first case only: the blocks' texels
   // and the entries are the alias sampler's.
   uint64_t seed = 1900;
@@ -229,7 +227,7 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
       if ((s == EnvmapSampler::Cdf && &c != &cases[0]) ||
           (smallTestSize() && (&c != &cases[0] || s != EnvmapSampler::Alias))) {
-        seed += methods.size();
+        seed += kMethodsWithBrdfSampling.size();
         continue;
       }
       const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
@@ -237,7 +235,7 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
                                      fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), "optimal", s);
       REQUIRE(scene.tables.hasBank());
       REQUIRE(scene.tables.bankVariances.entriesWithNegativeEq5 > 0);
-      for (auto [m, e] : methods) {
+      for (auto [m, e] : kMethodsWithBrdfSampling) {
         Rendering r = renderWith(scene, m, e, 60, ++seed);
         MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
         double z = zScore(mean.mean, expected, mean.standardError);

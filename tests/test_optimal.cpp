@@ -47,7 +47,7 @@ double optimalMass(const Nodes& x, double lambda, double c) {
 
 }  // namespace
 
-TEST_CASE("λ of [Kar19] eq. 9 lies within eq. 10's bounds and normalises p*, on stiff cases", "[optimal]") {
+TEST_CASE("eq. 10's bounds bracket the λ of [Kar19] eq. 9, which normalises p*, on stiff cases", "[optimal]") {
   // A 10⁶ sun off a lobe of n = 10⁵ (nearly all of p_ρ on one node), on it, and a
   // 10⁻⁶ sun; every share.
   for (double c : {0.05, 0.25, 0.5, 0.75, 0.95})
@@ -57,10 +57,10 @@ TEST_CASE("λ of [Kar19] eq. 9 lies within eq. 10's bounds and normalises p*, on
         OptimalLambda l = solveOptimalLambda(x.f.data(), x.q.data(), x.w.data(), x.f.size(), x.F, c);
         INFO("c " << c << " sun " << sun << " at node " << sunNode << ": lambda " << l.lambda << " in [" << l.lower
                   << ", " << l.upper << "]");
-        CHECK(l.lower == Approx(c * x.F * x.F));
-        CHECK(l.upper == Approx(x.F * x.F / c));
-        CHECK(l.lambda >= l.lower);
-        CHECK(l.lambda <= l.upper);
+        // Eq. 10 brackets the λ that normalises p*: ∫ p* falls as λ grows, so it is at
+        // least 1 at the lower bound and at most 1 at the upper (with rounding's slack).
+        CHECK(optimalMass(x, c * x.F * x.F, c) >= 1 - 1e-12);
+        CHECK(optimalMass(x, x.F * x.F / c, c) <= 1 + 1e-12);
         CHECK(optimalMass(x, l.lambda, c) == Approx(1).epsilon(1e-9));
       }
 }
@@ -125,7 +125,6 @@ TEST_CASE("the bank's eq. 9 is never worse than eq. 6, and equals it where eq. 5
     const Scene scene = smallScene("rooitou_park", "seed000", 16, 16, false, EnvmapSampler::Alias, 0, "optimal");
     const BankVariances& v = scene.tables.bankVariances;
     CHECK(v.entriesWithNegativeEq5 > 0);
-    CHECK(v.compensatedOverOptimalMax >= v.compensatedOverOptimalMean);
     CHECK(v.compensatedOverOptimalMean >= 1 - 1e-9);
     CHECK(v.compensatedOverOptimalMax > 1.01);
   }

@@ -209,23 +209,26 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
     }
     MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
   };
+  // add(l, g) for g of sample x at every combination l, lanes vectorised.
+  auto forEachQuotient = [&](const float* x, auto add) {
+    for (int l0 = 0; l0 < padded; l0 += kPass)
+#pragma omp simd
+      for (int lane = 0; lane < 16; ++lane) {
+        float g[kGridVectors];
+        quotients(x, l0, lane, g);
+        for (int v = 0; v < kGridVectors; ++v) add(l0 + 16 * v + lane, g[v]);
+      }
+  };
   if (setup.rule == MA_RULE_MAX_ENTROPY) {
     for (int j = 0; j < M; ++j) {
       float* s = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
       float* s2 = sums + kern::runningSumIndex(0, j, 1, 0, M, padded);
       const float* x = prepared + kern::preparedFirst(added, j) * (M + 1);
       for (int i = 0; i < added.nonZero[j]; ++i, x += M + 1)
-        for (int l0 = 0; l0 < padded; l0 += kPass)
-#pragma omp simd
-          for (int lane = 0; lane < 16; ++lane) {
-            float g[kGridVectors];
-            quotients(x, l0, lane, g);
-            for (int v = 0; v < kGridVectors; ++v) {
-              int l = l0 + 16 * v + lane;
-              s[l] += g[v];
-              s2[l] = std::fma(g[v], g[v], s2[l]);
-            }
-          }
+        forEachQuotient(x, [&](int l, float g) {
+          s[l] += g;
+          s2[l] = std::fma(g, g, s2[l]);
+        });
     }
     return;
   }
@@ -238,17 +241,10 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   for (int i = 0; i < kern::preparedFirst(added, M); ++i, x += M + 1) {
     float r[M];
     const float w = kern::mixtureWeights(M, stageMix, x, r);
-    for (int l0 = 0; l0 < padded; l0 += kPass)
-#pragma omp simd
-      for (int lane = 0; lane < 16; ++lane) {
-        float g[kGridVectors];
-        quotients(x, l0, lane, g);
-        for (int v = 0; v < kGridVectors; ++v) {
-          int l = l0 + 16 * v + lane;
-          sumS2[l] = std::fma(g[v], w, sumS2[l]);
-          for (int j = 0; j < M; ++j) sumM[j][l] = std::fma(g[v], r[j], sumM[j][l]);
-        }
-      }
+    forEachQuotient(x, [&](int l, float g) {
+      sumS2[l] = std::fma(g, w, sumS2[l]);
+      for (int j = 0; j < M; ++j) sumM[j][l] = std::fma(g, r[j], sumM[j][l]);
+    });
   }
 }
 

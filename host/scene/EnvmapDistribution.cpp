@@ -252,11 +252,7 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   // Texels: RGB and the probability within the block.
   const int side = 1 << options.blockLog2;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
-  std::vector<double> blockMass(std::size_t(across) * down, 0.0);
-  for (int row = 0; row < height; ++row) {
-    double* mass = blockMass.data() + std::size_t(row >> options.blockLog2) * across;
-    for (int col = 0; col < width; ++col) mass[col >> options.blockLog2] += weights[std::size_t(row) * width + col];
-  }
+  const std::vector<double>& blockMass = bank.plainBlockMass;
   tables.texels.resize(weights.size() * 4);
 #pragma omp parallel for schedule(static)
   for (int row = 0; row < height; ++row) {

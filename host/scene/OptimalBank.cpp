@@ -90,7 +90,9 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
     std::size_t block = 0;
   };
   std::vector<Cell> cells(std::size_t(cellsAcross) * cellsDown);
-  std::vector<double> plainMass(blocks, 0.0);
+  OptimalBankWeights bank;
+  std::vector<double>& plainMass = bank.plainBlockMass;
+  plainMass.assign(blocks, 0.0);
   for (int row = 0; row < height; ++row) {
     const double sinTheta = std::sin(kPi * (row + 0.5) / height);
     Cell* cellRow = cells.data() + std::size_t(row >> cellLog2) * cellsAcross;
@@ -114,7 +116,6 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
       cell.block = std::size_t(cellRow * cellSide / side) * across + cellCol * cellSide / side;
     }
   const int binCount = int(bins.centres.size()), shares = options.shares;
-  OptimalBankWeights bank;
   bank.entries.resize(std::size_t(binCount) * shares);
   std::vector<double> compensatedRatio(bank.entries.size(), 1);
   std::vector<char> negative(bank.entries.size(), 0);

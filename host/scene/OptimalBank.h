@@ -46,6 +46,7 @@ struct BankVariances {
 // sees no light keeps the plain block weights.
 struct OptimalBankWeights {
   std::vector<std::vector<double>> entries;
+  std::vector<double> plainBlockMass;  // Σ of plainWeights over each block
   BankVariances variances;
 };
 OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, int width, int height,
