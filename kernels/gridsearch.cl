@@ -113,6 +113,15 @@ MA_FN int bestIndex(LaneBest best) {
   return l;
 }
 
+// The score of bestIndex's candidate: the highest, which no NaN reaches (keepBetter).
+MA_FN float bestScore(LaneBest best) {
+  float score[16];
+  vstore16(best.score, 0, score);
+  float top = -INFINITY;
+  for (int lane = 0; lane < 16; ++lane) top = score[lane] > top ? score[lane] : top;
+  return top;
+}
+
 // The running sums of the combinations l0 … l0 + MA_PASS − 1 of technique j, at
 // `sums` = the pixel's first, brought to the current scale (sumsRescale; 0: none yet).
 MA_FN void loadSums(__global const float* sums, int j, int l0, int paddedSize, float rescale, float16* sumG,
@@ -137,13 +146,15 @@ MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const 
 }
 
 // [HS14] Alg. 1 lines 5–13 for one pixel: adds the samples prepared at `prepared`
-// (summarised in `added`) to its running sums at `sums`, and, if `rank`, returns the
+// (summarised in `added`) to its running sums at `sums`, which it stores back if
+// `keepSums` (a search follows that adds to them), and, if `rank`, returns the
 // best l₀ by the sums of all its samples (summarised in `all`), or −1 if no
 // combination could be ranked. Rule (b) scores 16 combinations per float16; rule (a)
 // takes its logarithms one combination at a time.
 MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelSummary all, float rescale,
-                      __global float* sums, int rank, __global const float* gridLanes, __global const float* gridCost,
-                      int gridSize, int paddedSize, const float* cost, int rule, __global float* scores) {
+                      __global float* sums, int keepSums, int rank, __global const float* gridLanes,
+                      __global const float* gridCost, int gridSize, int paddedSize, const float* cost, int rule,
+                      __global float* scores) {
   float invCount[MA_TECHNIQUES], stageMix[MA_TECHNIQUES];
   for (int j = 0; j < MA_TECHNIQUES; ++j) invCount[j] = 1.0f / all.count[j];
   const float invTotal = 1.0f / sampleCount(MA_TECHNIQUES, all);
@@ -163,7 +174,8 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
     } else {
       sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES), alpha, stageMix, sumG, sumG2[0]);
     }
-    for (int j = 0; j < MA_TECHNIQUES; ++j) storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
+    if (keepSums)
+      for (int j = 0; j < MA_TECHNIQUES; ++j) storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
     if (!rank) continue;
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       float16 g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
@@ -202,7 +214,8 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
 
 // One work-item per block of 16 pixels. `taken` samples per pixel are new since the
 // previous search; `summaries` (per pixel) and `sums` (runningSumIndex) hold what the
-// searches before added. gridLanes[k · paddedSize + l] = α_{k,l} and gridCost[l] =
+// searches before added; `keepSums` 0 leaves `sums` unwritten (no search follows), and
+// then the searches before must have added nothing. gridLanes[k · paddedSize + l] = α_{k,l} and gridCost[l] =
 // Σ_k c_k α_{k,l}, both padded past gridSize with the last combination; cost[k] = c_k;
 // `prepared` has taken · (M + 1) floats per pixel (prepareSample). Outputs per pixel: α
 // (M floats), the selected index l₀ (−1 where the pixel fell back to equal weights),
@@ -212,7 +225,7 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
                          __global const float* gridLanes, __global const float* gridCost, int gridSize, int paddedSize,
                          __global const float* cost, int rule, __global float* prepared,
-                         __global PixelSummary* summaries, __global float* sums, __global float* alphaOut,
+                         __global PixelSummary* summaries, __global float* sums, int keepSums, __global float* alphaOut,
                          __global int* selectedOut, __global uint* fallbacksOut, __global float* scoresOut,
                          __global float* scaleOut) {
   int block = (int)get_global_id(0);
@@ -250,8 +263,9 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
     // Pixels that cannot be ranked yet keep their sums for the searches to come.
     if (hasSums(all[lane]))
       best = searchPixel(blockPrepared + lane * taken * (MA_TECHNIQUES + 1), added[lane], all[lane], rescale[lane],
-                         sums + runningSumIndex(pixel, 0, 0, 0, MA_TECHNIQUES, paddedSize), fallbacks[lane] == 0u,
-                         gridLanes, gridCost, gridSize, paddedSize, c, rule, scoresOut + (size_t)pixel * paddedSize);
+                         sums + runningSumIndex(pixel, 0, 0, 0, MA_TECHNIQUES, paddedSize), keepSums,
+                         fallbacks[lane] == 0u, gridLanes, gridCost, gridSize, paddedSize, c, rule,
+                         scoresOut + (size_t)pixel * paddedSize);
     // No combination could be ranked: non-finite sums, or for rule (a) no λ that
     // is a distribution (eq. 4.16 has no solution on the grid).
     if (fallbacks[lane] == 0u && best < 0)
@@ -266,70 +280,78 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
   }
 }
 
-// The pooled score of combination l for the window w: Σ_q score_q,l · (scaleMin/scale_q)²
-// over the window's ranked pixels q, in row-major order, as one fma chain.
-MA_FN float pooledScore(__global const float* scores, __global const float* scales, __global const uint* fallbacks,
-                        PoolWindow w, int width, int paddedSize, float scaleMin, int l) {
-  float sum = 0.0f;
-  for (int y = w.y0; y <= w.y1; ++y)
-    for (int x = w.x0; x <= w.x1; ++x) {
-      int q = y * width + x;
-      if (fallbacks[q] == 0u) sum = fma(scores[(size_t)q * paddedSize + l], poolingFactor(scaleMin, scales[q]), sum);
-    }
-  return sum;
-}
-
 // [HS14] Alg. 1 line 13, rule (b), over every pixel's window of `radius` (kernels/gridsearch.h,
 // poolWindow), and the skip rule; one work-item per pixel. Reads gridSearch's outputs:
 // the scores, scales, and its α, l₀ and fallbacks (alpha, selected, fallbacks), which a
 // pixel with no ranked pixel in its window keeps. Writes α, l₀ (−1 where the pixel fell
-// back or skipped) and the fallback and skip flags.
+// back or skipped), the fallback and skip flags, and V(equal)/V(selected) as the window
+// predicts it (pooledVarianceRatio; 1 where the pixel skipped or kept its own α).
 __kernel void selectPooled(__global const float* scores, __global const float* scales, __global const float* alpha,
                            __global const int* selected, __global const uint* fallbacks, int width, int height,
-                           int radius, __global const float* gridLanes, int gridSize, int paddedSize, int equal,
-                           float minGain, __global float* alphaOut, __global int* selectedOut,
-                           __global uint* fallbacksOut, __global uchar* skippedOut) {
+                           int radius, __global const float* gridLanes, __global const float* gridCost, int gridSize,
+                           int paddedSize, int equal, float minGain, __global float* alphaOut,
+                           __global int* selectedOut, __global uint* fallbacksOut, __global uchar* skippedOut,
+                           __global float* varianceRatioOut) {
   int pixel = (int)get_global_id(0);
   if (pixel >= width * height) return;
   PoolWindow w = poolWindow(pixel, width, height, radius);
   float scaleMin = INFINITY;
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x)
-      if (fallbacks[y * width + x] == 0u) scaleMin = fmin(scaleMin, scales[y * width + x]);
+      if (pools(w, y * width + x, fallbacks[y * width + x])) scaleMin = fmin(scaleMin, scales[y * width + x]);
   int best = -1, skipped = 0;
+  float ratio = 1.0f;
   if (scaleMin < INFINITY) {
     const int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     LaneBest top = {(float16)(-INFINITY), (int16)(-1)};
-    for (int l0 = 0; l0 < gridSize; l0 += 16) {
-      float16 sum = 0.0f;
+    float pooledEqual = 0.0f;
+    // A pass of MA_PASS combinations per visit of a neighbour: its factor once, and
+    // MA_GRID_VECTORS independent chains. Each lane is Σ_q score_q,l · (scaleMin/scale_q)²
+    // over the window's pooled pixels q in row-major order, one fma chain, as the
+    // reference's pooledScore (host/sampling/GridSearch.cpp).
+    for (int l0 = 0; l0 < gridSize; l0 += MA_PASS) {
+      float16 sum[MA_GRID_VECTORS];
+      MA_UNROLL
+      for (int v = 0; v < MA_GRID_VECTORS; ++v) sum[v] = 0.0f;
       for (int y = w.y0; y <= w.y1; ++y)
         for (int x = w.x0; x <= w.x1; ++x) {
           int q = y * width + x;
-          if (fallbacks[q] == 0u)
-            sum = fma(vload16(0, scores + (size_t)q * paddedSize + l0), (float16)poolingFactor(scaleMin, scales[q]), sum);
+          if (!pools(w, q, fallbacks[q])) continue;
+          float16 factor = (float16)poolingFactor(scaleMin, scales[q]);
+          __global const float* s = scores + (size_t)q * paddedSize + l0;
+          MA_UNROLL
+          for (int v = 0; v < MA_GRID_VECTORS; ++v) sum[v] = fma(vload16(v, s), factor, sum[v]);
         }
-      keepBetter(&top, sum, l0 + lanes, gridSize);
+      float passSums[MA_PASS];
+      MA_UNROLL
+      for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+        keepBetter(&top, sum[v], l0 + 16 * v + lanes, gridSize);
+        vstore16(sum[v], v, passSums);
+      }
+      if (equal >= l0 && equal < l0 + MA_PASS) pooledEqual = passSums[equal - l0];
     }
     best = bestIndex(top);
     float sumD = 0.0f, sumD2 = 0.0f, count = 0.0f;
     for (int y = w.y0; y <= w.y1; ++y)
       for (int x = w.x0; x <= w.x1; ++x) {
         int q = y * width + x;
-        if (fallbacks[q] != 0u) continue;
+        if (!pools(w, q, fallbacks[q])) continue;
         __global const float* s = scores + (size_t)q * paddedSize;
         float d = (s[best] - s[equal]) * poolingFactor(scaleMin, scales[q]);
         sumD += d;
         sumD2 = fma(d, d, sumD2);
         count += 1.0f;
       }
-    skipped = skipsAdapting(pooledScore(scores, scales, fallbacks, w, width, paddedSize, scaleMin, best),
-                            pooledScore(scores, scales, fallbacks, w, width, paddedSize, scaleMin, equal), minGain,
-                            sumD, sumD2, count);
+    float pooledBest = bestScore(top);
+    skipped = skipsAdapting(pooledBest, pooledEqual, minGain, sumD, sumD2, count);
+    if (!skipped && w.self >= 0) ratio = pooledVarianceRatio(pooledBest, gridCost[best], pooledEqual, gridCost[equal]);
   }
   for (int k = 0; k < MA_TECHNIQUES; ++k)
-    alphaOut[pixel * MA_TECHNIQUES + k] = best < 0 ? alpha[pixel * MA_TECHNIQUES + k]
-                                          : (skipped ? 1.0f / MA_TECHNIQUES : gridLanes[k * paddedSize + best]);
+    alphaOut[pixel * MA_TECHNIQUES + k] = best < 0
+                                              ? alpha[pixel * MA_TECHNIQUES + k]
+                                              : (skipped ? 1.0f / MA_TECHNIQUES : gridLanes[k * paddedSize + best]);
   selectedOut[pixel] = best < 0 ? selected[pixel] : (skipped ? -1 : best);
   fallbacksOut[pixel] = best < 0 ? fallbacks[pixel] : 0u;
   skippedOut[pixel] = (uchar)skipped;
+  varianceRatioOut[pixel] = ratio;
 }

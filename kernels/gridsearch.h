@@ -284,9 +284,13 @@ MA_FN float poolingFactor(float scaleMin, float scale) {
   return r * r;
 }
 
-// The window of radius r around pixel (x, y), clipped at the image's edges.
+// The window of radius r around pixel (x, y), clipped at the image's edges. For r > 0
+// it leaves the pixel itself out: its α and its pilot's weight then come from its
+// neighbours' samples only, so that the weight is independent of the pilot it weighs
+// (host/render/Render.h, pilotWeight).
 typedef struct {
   int x0, x1, y0, y1;
+  int self;  // the pixel left out, −1 for none
 } PoolWindow;
 
 MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius) {
@@ -296,7 +300,20 @@ MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius) {
   w.x1 = x + radius > width - 1 ? width - 1 : x + radius;
   w.y0 = y - radius < 0 ? 0 : y - radius;
   w.y1 = y + radius > height - 1 ? height - 1 : y + radius;
+  w.self = radius > 0 ? pixel : -1;
   return w;
+}
+
+// Whether pixel q of window w, with fallback bits `fallback`, enters the pooled sums.
+MA_FN int pools(PoolWindow w, int q, ma_uint fallback) { return q != w.self && fallback == 0u; }
+
+// V(equal)/V(selected), the variances (not cost × variance) that the pooled scores
+// (≤ 0) predict, from those scores and the costs per sample of the two combinations;
+// +∞ where the selected one has none. Only for a selection that did not skip, so that
+// equal weights have some variance.
+MA_FN float pooledVarianceRatio(float best, float bestCost, float equal, float equalCost) {
+  float varianceBest = -best / bestCost, varianceEqual = -equal / equalCost;
+  return varianceBest > 0.0f ? varianceEqual / varianceBest : INFINITY;
 }
 
 // The skip rule, from the pooled scores of the best and the equal combination and the

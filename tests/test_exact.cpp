@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -57,10 +58,10 @@ StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, int tech
 }
 
 // One search object per shape, reset before each use: building one compiles the kernel.
-GridSearch& deviceSearch(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize) {
-  static std::map<std::tuple<int, int, int>, std::unique_ptr<GridSearch>> searches;
-  auto& search = searches[{techniqueCount, pixelCount, gridSize}];
-  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount, pixelCount, gridSize);
+GridSearch& deviceSearch(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true) {
+  static std::map<std::tuple<int, int, int, bool>, std::unique_ptr<GridSearch>> searches;
+  auto& search = searches[{techniqueCount, pixelCount, gridSize, runningSums}];
+  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount, pixelCount, gridSize, runningSums);
   search->reset();
   return *search;
 }
@@ -75,12 +76,14 @@ struct BothResults {
 };
 
 BothResults searchBoth(const std::vector<PixelSampleList>& pixels, int techniqueCount, const std::vector<double>& costs,
-                       GridRule rule, int gridSize = kDefaultGridSize, int capacity = 0) {
+                       GridRule rule, int gridSize = kDefaultGridSize, int capacity = 0,
+                       const std::optional<PooledSelection>& pooling = std::nullopt) {
   StoredSampleLayout layout = layoutOf(pixels, techniqueCount, std::max(capacity, int(pixels.front().size())));
   std::vector<float> samples = store(pixels, layout);
   GridSearchReference reference(techniqueCount, layout.pixelCount, gridSize);
-  return {deviceSearch(techniqueCount, layout.pixelCount, gridSize).run(deviceBuffer(samples), layout, costs, rule),
-          reference.run(samples, layout, costs, rule)};
+  return {deviceSearch(techniqueCount, layout.pixelCount, gridSize)
+              .run(deviceBuffer(samples), layout, costs, rule, pooling),
+          reference.run(samples, layout, costs, rule, pooling)};
 }
 
 // The same samples added in stages of `stageSize`, one search after each, as
@@ -404,4 +407,81 @@ TEST_CASE("a layout that does not match the samples or the search is rejected", 
   CHECK(reference.run(samples, layout, costs).fallbackCount() == 0);
   CHECK_THROWS_AS(GridSearchReference(1, 3), std::invalid_argument);
   CHECK_THROWS_AS(GridSearchReference(2, 3, 0), std::invalid_argument);
+}
+
+TEST_CASE("a search without running sums selects as one with them, and refuses a second search", "[exact]") {
+  const int m = 2, width = 20, height = 15;
+  auto pixels = randomPixels(m, width * height, 40, 5);
+  StoredSampleLayout layout = layoutOf(pixels, m, 40);
+  std::vector<float> samples = store(pixels, layout);
+  const std::vector<double> costs{1.0, 2.5};
+  const PooledSelection pooling{width, height, 2, 0.02};
+  GridSearchReference keeping(m, width * height), single(m, width * height, kDefaultGridSize, false);
+  GridSearch& device = deviceSearch(m, width * height, kDefaultGridSize, false);
+  GridSearchResult kept = keeping.run(samples, layout, costs, GridRule::MinCostVariance, pooling);
+  for (const GridSearchResult& r :
+       {single.run(samples, layout, costs, GridRule::MinCostVariance, pooling),
+        device.run(deviceBuffer(samples), layout, costs, GridRule::MinCostVariance, pooling)}) {
+    CHECK(r.selected == kept.selected);
+    CHECK(r.skipped == kept.skipped);
+    CHECK(r.varianceRatio == kept.varianceRatio);
+  }
+  CHECK_THROWS_AS(single.run(samples, layout, costs), std::logic_error);
+  CHECK_THROWS_AS(device.run(deviceBuffer(samples), layout, costs), std::logic_error);
+  single.reset();
+  keeping.reset();
+  CHECK(single.run(samples, layout, costs).selected == keeping.run(samples, layout, costs).selected);
+  CHECK(gridSearchBytesPerPixel(m, kDefaultGridSize, false) < gridSearchBytesPerPixel(m, kDefaultGridSize, true) / 3);
+}
+
+TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not its own", "[exact]") {
+  // The pilot's weight (host/render/Render.cpp, pilotWeight) must not depend on the
+  // pilot it weighs: the selection, the skip and the variance ratio of a pixel stay
+  // the same, bit for bit, when its own samples change, while its neighbours see the
+  // change. The kernel selects as its reference.
+  // Every pixel has the same integrand, √x + 0.2, whose best α is inside the grid, its
+  // stratified samples' values scaled by noise of its own.
+  const int m = 2, width = 20, height = 12, self = 5 * width + 7;
+  const std::vector<double> costs{1.0, 2.5};
+  std::mt19937_64 rng(11);
+  std::lognormal_distribution<double> noise(0.0, 0.3);
+  auto noisy = [&] {
+    PixelSampleList samples = stratified(sqrtPlus, m, 20);
+    for (Sample& s : samples) s.f *= float(noise(rng));
+    return samples;
+  };
+  std::vector<PixelSampleList> pixels(width * height);
+  for (PixelSampleList& pixel : pixels) pixel = noisy();
+  auto changed = pixels;
+  changed[self] = noisy();
+  const PooledSelection pooling{width, height, 2, 0.02};
+  BothResults before = searchBoth(pixels, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
+  BothResults after = searchBoth(changed, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
+  for (const BothResults* r : {&before, &after}) {
+    CHECK(r->device.selected == r->reference.selected);
+    CHECK(r->device.skipped == r->reference.skipped);
+    CHECK(r->device.varianceRatio == r->reference.varianceRatio);
+  }
+  const int adapted = int(std::count(before.reference.skipped.begin(), before.reference.skipped.end(), 0));
+  INFO(fmt::format("{} of {} pixels adapt", adapted, width * height));
+  CHECK(adapted > width * height / 2);
+  CHECK(before.reference.skipped[self] == 0);
+  for (int p = 0; p < width * height; ++p) {
+    if (before.reference.skipped[p]) CHECK(before.reference.varianceRatio[p] == 1.0f);
+    CHECK(before.reference.varianceRatio[p] > 0.0f);
+  }
+  CHECK(after.reference.selected[self] == before.reference.selected[self]);
+  CHECK(after.reference.skipped[self] == before.reference.skipped[self]);
+  CHECK(after.reference.varianceRatio[self] == before.reference.varianceRatio[self]);
+  CHECK(after.reference.allocations[self].alpha == before.reference.allocations[self].alpha);
+  int moved = 0;
+  for (int y = 3; y <= 7; ++y)
+    for (int x = 5; x <= 9; ++x)
+      moved += after.reference.varianceRatio[y * width + x] != before.reference.varianceRatio[y * width + x];
+  CHECK(moved >= 20);
+  // Radius 0: every pixel by its own samples, and no ratio to weigh a pilot by.
+  BothResults own = searchBoth(pixels, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 0,
+                               PooledSelection{width, height, 0, 0.02});
+  CHECK(
+      std::all_of(own.device.varianceRatio.begin(), own.device.varianceRatio.end(), [](float r) { return r == 1.0f; }));
 }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -10,11 +9,12 @@ namespace misalloc {
 
 namespace {
 
-double validatedSum(const std::vector<double>& alpha) {
+double validatedSum(const double* alpha, int m) {
   double sum = 0;
-  for (double a : alpha) {
-    if (!(std::isfinite(a) && a >= 0)) throw std::invalid_argument("apportionCounts: weights must be finite and >= 0");
-    sum += a;
+  for (int k = 0; k < m; ++k) {
+    if (!(std::isfinite(alpha[k]) && alpha[k] >= 0))
+      throw std::invalid_argument("apportionCounts: weights must be finite and >= 0");
+    sum += alpha[k];
   }
   if (sum == 0) throw std::invalid_argument("apportionCounts: weights sum to 0");
   return sum;
@@ -22,25 +22,33 @@ double validatedSum(const std::vector<double>& alpha) {
 
 }  // namespace
 
-std::vector<int> apportionCounts(const std::vector<double>& alpha, int total) {
+void apportionCounts(const double* alpha, int m, int total, int* counts) {
   if (total < 0) throw std::invalid_argument("apportionCounts: negative total " + std::to_string(total));
-  double sum = validatedSum(alpha);
-  std::size_t m = alpha.size();
-  std::vector<int> counts(m);
-  std::vector<double> remainder(m);
+  double sum = validatedSum(alpha, m);
   int assigned = 0;
-  for (std::size_t k = 0; k < m; ++k) {
+  for (int k = 0; k < m; ++k) {
     double quota = alpha[k] / sum * total;
     counts[k] = std::min(static_cast<int>(std::floor(quota)), total - assigned);
-    remainder[k] = quota - counts[k];
     assigned += counts[k];
   }
-  std::vector<std::size_t> order(m);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return remainder[a] > remainder[b]; });
-  // Σ ⌊quota⌋ > N − m, so fewer than m techniques receive one more sample.
-  for (std::size_t r = 0; assigned < total; ++r, ++assigned) ++counts[order[r]];
+  // Σ ⌊quota⌋ > N − m, so fewer than m techniques receive one more sample: each to the
+  // largest remainder not yet served, ties to the lower index.
+  unsigned served = 0;
+  for (; assigned < total; ++assigned) {
+    int next = -1;
+    double largest = -1;
+    for (int k = 0; k < m; ++k) {
+      double remainder = alpha[k] / sum * total - counts[k];
+      if (!(served >> k & 1u) && remainder > largest) largest = remainder, next = k;
+    }
+    served |= 1u << next;
+    ++counts[next];
+  }
+}
+
+std::vector<int> apportionCounts(const std::vector<double>& alpha, int total) {
+  std::vector<int> counts(alpha.size());
+  apportionCounts(alpha.data(), int(alpha.size()), total, counts.data());
   return counts;
 }
 

@@ -10,5 +10,8 @@ namespace misalloc {
 // Σ n_k = N exactly. alpha is normalised first. Throws std::invalid_argument on a
 // negative or non-finite weight, weights summing to 0, or N < 0.
 std::vector<int> apportionCounts(const std::vector<double>& alpha, int total);
+// The same for the m weights at `alpha` into `counts`, without allocating: a render
+// apportions every pixel's stage.
+void apportionCounts(const double* alpha, int m, int total, int* counts);
 
 }  // namespace misalloc

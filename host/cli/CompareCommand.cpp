@@ -91,10 +91,9 @@ int runCompare(CompareArgs& args) {
   compare.device = args.devices.spec();
   validateCompareOptions(compare);
   for (const CompareCase& c : compare.cases)
-    for (Method m : compare.methods)
-      for (int budget : compare.budgets)
-        requireStatisticsMemory(c.scene, m, "--budgets", budget, compare.adaptive, args.devices.onHost(),
-                                args.devices.samplerCount());
+    for (int budget : compare.budgets)
+      requireStatisticsMemory(c.scene, compare.methods, "--budgets", budget, compare.adaptive, args.devices.onHost(),
+                              args.devices.samplerCount());
   requireBrdfCoverage(compare);
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
@@ -131,7 +130,8 @@ Subcommand addCompareCommand(CLI::App& app) {
   command->add_option("--methods", args->methods, "comma-separated methods, or all")->capture_default_str();
   command->add_option("--budgets", args->budgets, "samples per pixel, ascending")->capture_default_str();
   command
-      ->add_option("--envmap-pdfs", args->envmapPdfs, "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal")
+      ->add_option("--envmap-pdfs", args->envmapPdfs,
+                   "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal")
       ->capture_default_str();
   command->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
       ->capture_default_str()

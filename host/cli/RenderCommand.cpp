@@ -71,7 +71,7 @@ int runRender(RenderArgs& args) {
     throw InputError(
         fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
-  requireStatisticsMemory(scene.options, m, "--spp", args.spp, adaptive, args.devices.onHost(),
+  requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
   auto sampler = args.devices.makeSampler(scene, config, args.localSize);
   std::string deviceName = args.devices.name();

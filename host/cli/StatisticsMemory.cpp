@@ -5,9 +5,17 @@
 #include "MemoryBudget.h"
 
 namespace misalloc {
+namespace {
 
-void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::string& sppOption, int spp,
-                             const AdaptiveOptions& adaptive, bool onHost, int samplers) {
+struct MemoryNeed {
+  std::string what;
+  double bytes = 0;
+};
+
+// What one method's sampler keeps beyond the render itself.
+void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& scene, Method m,
+                            const std::string& sppOption, int spp, const AdaptiveOptions& adaptive, bool onHost,
+                            int samplers) {
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
   const double pixels = double(scene.width) * scene.height, M = scene.splitBrdf ? 3 : 2;
   if (config.sampleCapacity > 0) {
@@ -18,23 +26,40 @@ void requireStatisticsMemory(const SceneOptions& scene, Method m, const std::str
     const double perPixel = double(config.sampleCapacity) * (M + 2) * sizeof(float) * copies;
     std::string option = fmt::format("{} {}", sppOption, spp);
     if (methodTraits(m).split == Split::Probed) option += fmt::format(" and --oracle-spp {}", adaptive.oracleSamples);
-    requireHostMemory(fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
-                                  methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * copies),
-                      pixels * perPixel);
+    needs.push_back({fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
+                                 methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * copies),
+                     pixels * perPixel});
   }
   if (config.gridSize > 0) {
     // The weight grid, M weights and a cost per combination, is built on the host; the
     // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
-    // (sampling/GridSearch.h). Both from the options alone: building the grid to size it
-    // would be the allocation this check prevents.
+    // where a render searches more than once (sampling/GridSearch.h). Both from the
+    // options alone: building the grid to size it would be the allocation this check
+    // prevents.
     const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
-    const double sumBytes = onHost ? pixels * 2 * M * U * sizeof(float) : 0;
-    requireHostMemory(
-        fmt::format(
-            "--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U, (M + 1) * sizeof(float),
-            sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, 2 * M * U * sizeof(float)) : ""),
-        gridBytes + sumBytes);
+    const double sumBytes = onHost && config.runningSums ? pixels * 2 * M * U * sizeof(float) : 0;
+    needs.push_back(
+        {fmt::format(
+             "--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U, (M + 1) * sizeof(float),
+             sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, 2 * M * U * sizeof(float)) : ""),
+         gridBytes + sumBytes});
   }
+}
+
+}  // namespace
+
+void requireStatisticsMemory(const SceneOptions& scene, const std::vector<Method>& methods,
+                             const std::string& sppOption, int spp, const AdaptiveOptions& adaptive, bool onHost,
+                             int samplers) {
+  std::vector<MemoryNeed> needs;
+  for (Method m : methods) appendStatisticsMemory(needs, scene, m, sppOption, spp, adaptive, onHost, samplers);
+  if (needs.empty()) return;
+  MemoryNeed total = needs.front();
+  for (size_t i = 1; i < needs.size(); ++i) {
+    total.what += " and " + needs[i].what;
+    total.bytes += needs[i].bytes;
+  }
+  requireHostMemory(total.what, total.bytes);
 }
 
 }  // namespace misalloc

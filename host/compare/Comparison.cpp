@@ -168,19 +168,25 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
-    for (Method method : options.methods)
-      for (int budget : options.budgets) {
-        // Built (and its kernels compiled) once; each render starts it afresh.
-        auto sampler = devices.makeSampler(scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive),
-                                           options.localSize);
-        for (int r = 0; r < options.repeats; ++r) {
+    // The repeats go round the methods, so that a stretch of load from elsewhere on a
+    // shared machine slows one repeat of every method rather than every repeat of one:
+    // the median times then compare methods under the same conditions.
+    for (int budget : options.budgets) {
+      // Built (and their kernels compiled) once per budget; each render starts afresh.
+      std::vector<std::unique_ptr<StageSampler>> samplers;
+      for (Method method : options.methods)
+        samplers.push_back(devices.makeSampler(
+            scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize));
+      for (int r = 0; r < options.repeats; ++r)
+        for (size_t m = 0; m < options.methods.size(); ++m) {
+          const Method method = options.methods[m];
           if (guard.requested()) {
             out.interrupted = true;
             writeRuns(options.outDir, out);
             return out;
           }
           const uint64_t seed = options.seed + uint64_t(r);
-          Rendering rendering = render(*sampler, method, adaptive, budget, seed);
+          Rendering rendering = render(*samplers[m], method, adaptive, budget, seed);
           out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference->image));
           if (r == 0) {
             std::string image = options.outDir + "/" + imagePath(c.label, method, budget);
@@ -192,7 +198,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
           writeRuns(options.outDir, out);
           meter.step(fmt::format("{} {} {} spp #{}", c.label, methodName(method), budget, r + 1));
         }
-      }
+    }
   }
   return out;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 
 #include "Error.h"
 #include "alloc/Apportion.h"
@@ -43,14 +44,14 @@ Allocation allocatePixel(Method method, const AdaptiveOptions& options, const Pi
 // 0; the estimate then rests on rare BRDF hits of the sun, unbiased yet so heavy-tailed
 // that it comes out low almost always (tests/test_stability.cpp). True if it changed
 // the counts: the report counts those pixels.
-bool floorCounts(std::vector<int>& counts) {
+bool floorCounts(int* counts, int m) {
   bool changed = false;
-  for (int& n : counts) {
-    if (n > 0) continue;
-    auto largest = std::max_element(counts.begin(), counts.end());
+  for (int k = 0; k < m; ++k) {
+    if (counts[k] > 0) continue;
+    int* largest = std::max_element(counts, counts + m);
     if (*largest <= 1) break;
     --*largest;
-    n = 1;
+    counts[k] = 1;
     changed = true;
   }
   return changed;
@@ -61,13 +62,21 @@ struct StageTotals {
   double kernelSeconds = 0;
 };
 
-// Adds a stage's estimate with its fixed weight N_b/N.
-void accumulateStage(StageTotals& totals, const StagePlan& plan, const StageResult& stage, Estimator estimator,
-                     double weight) {
-  for (size_t i = 0; i < totals.rgb.size(); ++i) totals.rgb[i] += weight * stage.rgb[i];
-  for (size_t p = 0; p < totals.variance.size(); ++p)
-    totals.variance[p] += weight * weight * stageVariance(plan, stage, int(p), estimator);
-  totals.kernelSeconds += stage.kernelSeconds;
+// A stage as it ran: its counts and its per-pixel estimates.
+struct TakenStage {
+  StagePlan plan;
+  StageResult result;
+};
+
+// Adds a stage's estimate with each pixel's weight.
+void accumulateStage(StageTotals& totals, const TakenStage& stage, Estimator estimator,
+                     const std::vector<double>& weights) {
+  for (size_t p = 0; p < totals.variance.size(); ++p) {
+    const double w = weights[p];
+    for (int c = 0; c < 3; ++c) totals.rgb[3 * p + c] += w * stage.result.rgb[3 * p + c];
+    totals.variance[p] += w * w * stageVariance(stage.plan, stage.result, int(p), estimator);
+  }
+  totals.kernelSeconds += stage.result.kernelSeconds;
 }
 
 }  // namespace
@@ -107,6 +116,11 @@ double stageVariance(const StagePlan& plan, const StageResult& result, int pixel
   return v;
 }
 
+double pilotWeight(float varianceRatio, int pilotSamples, int spp) {
+  const double r = std::isnan(varianceRatio) ? 1.0 : double(varianceRatio);
+  return pilotSamples / (pilotSamples + (spp - pilotSamples) * r);
+}
+
 namespace {
 
 // Everything a render has sampled so far.
@@ -125,30 +139,34 @@ struct Progress {
         skipped(pixels, 0) {}
 };
 
-// Runs one stage with the given counts and adds it, weighted N_b/N, to the estimate.
+// Runs one stage with the given counts; the caller adds it to the estimate.
 // `keepStatistics` false for the last stage, which no allocation reads.
-void takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples, int spp,
-               uint64_t seed, bool keepStatistics) {
-  const int M = sampler.scene().techniqueCount();
-  StagePlan plan;
-  plan.techniqueCount = M;
-  plan.stageSamples = stageSamples;
-  plan.samplesBefore = progress.samplesBefore;
-  plan.keepStatistics = keepStatistics;
-  plan.counts = std::move(counts);
-  plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
-  StageResult stage = sampler.run(plan, seed);
-  // Stage b's estimate is unbiased given the earlier stages, whatever its counts;
-  // weights N_b/N fixed in advance keep the combination unbiased.
-  accumulateStage(progress.totals, plan, stage, sampler.config().estimator, double(stageSamples) / spp);
-  for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += plan.counts[i];
+TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples,
+                     uint64_t seed, bool keepStatistics) {
+  TakenStage stage;
+  stage.plan.techniqueCount = sampler.scene().techniqueCount();
+  stage.plan.stageSamples = stageSamples;
+  stage.plan.samplesBefore = progress.samplesBefore;
+  stage.plan.keepStatistics = keepStatistics;
+  stage.plan.counts = std::move(counts);
+  stage.plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
+  stage.result = sampler.run(stage.plan, seed);
+  for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += stage.plan.counts[i];
   progress.samplesBefore += stageSamples;
+  return stage;
 }
+
+// The next stage's α per pixel, and V(equal)/V(α) where the pixel's neighbours predict
+// it (GridSearchResult::varianceRatio), 1 elsewhere.
+struct StageAllocation {
+  std::vector<Allocation> allocations;
+  std::vector<float> varianceRatio;
+};
 
 // Every pixel's weights from all its samples so far, the running sums pooled over
 // its neighbourhood.
-std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
-                                            Progress& progress) {
+StageAllocation allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
+                                    Progress& progress) {
   const Scene& scene = sampler.scene();
   if (methodTraits(method).searchesWeights) {
     std::optional<PooledSelection> pooling;
@@ -156,7 +174,7 @@ std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method
       pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
     GridSearchResult search = sampler.searchWeights(options.costs, options.gridRule, pooling);
     for (size_t p = 0; p < search.skipped.size(); ++p) progress.skipped[p] &= search.skipped[p];
-    return std::move(search.allocations);
+    return {std::move(search.allocations), std::move(search.varianceRatio)};
   }
   const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = sampler.statSlots();
   std::vector<double> stats = sampler.statistics();
@@ -171,12 +189,12 @@ std::vector<Allocation> allocateFromSamples(StageSampler& sampler, Method method
       samples = decodePixelSamples(stored, p, progress.samplesBefore, sampler.config().sampleCapacity, M);
     allocations[p] = allocatePixel(method, options, pixelStats, samples ? &*samples : nullptr);
   }
-  return allocations;
+  return {std::move(allocations), std::vector<float>(pixels, 1.0f)};
 }
 
 // The next stage's counts: the stage split by the current α. Each stage is its own
-// balance-heuristic estimate with its own counts, weighted N_b/N, so the render's
-// variance is Σ_b (N_b/N)² V(α_b)/N_b ([SHS16] eq. 21 per stage): each stage is best
+// balance-heuristic estimate with its own counts, weighted w_b, so the render's
+// variance is Σ_b w_b² V(α_b)/N_b ([SHS16] eq. 21 per stage): each stage is best
 // split by the best α known (tests/test_staging.cpp compares it with making the
 // cumulative counts approach α·N).
 std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocation>& allocations, int stageSamples) {
@@ -184,10 +202,10 @@ std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocatio
   std::vector<int32_t> out(progress.taken.size());
 #pragma omp parallel for schedule(static, 1024)
   for (size_t p = 0; p < allocations.size(); ++p) {
-    std::vector<int> counts = apportionCounts(allocations[p].alpha, stageSamples);
+    int* counts = out.data() + p * M;
+    apportionCounts(allocations[p].alpha.data(), M, stageSamples, counts);
     progress.fellBack[p] |= allocations[p].usedFallback() ? 1 : 0;
-    progress.floored[p] |= floorCounts(counts) ? 1 : 0;
-    std::copy(counts.begin(), counts.end(), out.begin() + p * M);
+    progress.floored[p] |= floorCounts(counts, M) ? 1 : 0;
   }
   return out;
 }
@@ -225,6 +243,7 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
     config.sampleCapacity =
         traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp);
     config.gridSize = options.gridSize;
+    config.runningSums = traits.split == Split::Staged && options.stages > 1;
   }
   return config;
 }
@@ -249,21 +268,23 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   sampler.reset();
   Rendering out;
   Progress progress(pixels, M);
+  const Estimator estimator = sampler.config().estimator;
   if (!isAdaptive(method)) {
-    takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, spp, seed, false);
+    TakenStage stage = takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false);
+    accumulateStage(progress.totals, stage, estimator, std::vector<double>(pixels, 1.0));
   } else if (methodTraits(method).split == Split::Probed) {
     validateCosts(options.costs, M);
     // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
     // seed of its own, stands in for the true variance as a function of α; the render
     // then takes the α it finds best in one stage.
     auto probeStart = Clock::now();
-    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples,
-              options.oracleSamples, ~seed, true);
+    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples, ~seed, true);
     std::vector<Allocation> best = sampler.searchWeights(options.costs, GridRule::MinCostVariance).allocations;
     out.allocationSeconds = secondsSince(probeStart);
     Progress render(pixels, M);
     render.samplesBefore = progress.samplesBefore;
-    takeStage(sampler, render, stageCounts(render, best, spp), spp, spp, seed, false);
+    TakenStage stage = takeStage(sampler, render, stageCounts(render, best, spp), spp, seed, false);
+    accumulateStage(render.totals, stage, estimator, std::vector<double>(pixels, 1.0));
     progress = std::move(render);
   } else {
     validateCosts(options.costs, M);
@@ -272,17 +293,25 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     out.stageCount = int(sizes.size());
     if (methodTraits(method).searchesWeights && options.gridRule == GridRule::MinCostVariance)
       std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
-    for (size_t b = 0; b < sizes.size(); ++b) {
-      std::vector<int32_t> counts;
-      if (b == 0) {
-        counts = equalCounts(pixels, M, sizes[0]);
-      } else {
-        auto allocationStart = Clock::now();
-        counts = stageCounts(progress, allocateFromSamples(sampler, method, options, progress), sizes[b]);
-        out.allocationSeconds += secondsSince(allocationStart);
+    TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true);
+    std::vector<double> pilotWeights;
+    for (size_t b = 1; b < sizes.size(); ++b) {
+      auto allocationStart = Clock::now();
+      StageAllocation next = allocateFromSamples(sampler, method, options, progress);
+      std::vector<int32_t> counts = stageCounts(progress, next.allocations, sizes[b]);
+      out.allocationSeconds += secondsSince(allocationStart);
+      if (b == 1) {
+        pilotWeights.resize(pixels);
+        for (int p = 0; p < pixels; ++p) pilotWeights[p] = pilotWeight(next.varianceRatio[p], sizes[0], spp);
+        accumulateStage(progress.totals, pilot, estimator, pilotWeights);
       }
-      takeStage(sampler, progress, std::move(counts), sizes[b], spp, seed, b + 1 < sizes.size());
+      TakenStage stage = takeStage(sampler, progress, std::move(counts), sizes[b], seed, b + 1 < sizes.size());
+      // The stages after the pilot share the rest of the weight by their sizes.
+      std::vector<double> weights(pixels);
+      for (int p = 0; p < pixels; ++p) weights[p] = (1 - pilotWeights[p]) * sizes[b] / double(spp - sizes[0]);
+      accumulateStage(progress.totals, stage, estimator, weights);
     }
+    out.meanPilotWeight = std::accumulate(pilotWeights.begin(), pilotWeights.end(), 0.0) / pixels;
   }
   out.fallbackPixels = size_t(std::count(progress.fellBack.begin(), progress.fellBack.end(), 1));
   out.flooredPixels = size_t(std::count(progress.floored.begin(), progress.floored.end(), 1));

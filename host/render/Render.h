@@ -35,6 +35,7 @@ struct Rendering {
   size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
   size_t skippedPixels = 0;      // pixels that the skip rule kept at equal weights in every stage
   int stageCount = 1;
+  double meanPilotWeight = 0;          // staged methods: the pilot's weight in the estimate, mean over pixels
   double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
   double kernelSeconds = 0;            // device time of the sampling kernels (profiling events)
   double allocationSeconds = 0;        // reading statistics back and allocating
@@ -56,5 +57,14 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
 // with estimated σ_k); one-sample: s² / N over all samples ([SHS16] Table 2);
 // count-independent weights: Σ_k s_k² / n_k ([SHS16] eq. 28).
 double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator);
+
+// The pilot's weight in the estimate. The stages are independent unbiased estimates,
+// best combined with weights ∝ N_b/V_b. The pilot took N_0 samples at equal counts and
+// the stages after it N − N_0 at α, so with r = V(equal)/V(α) that is
+// N_0 / (N_0 + (N − N_0) r): N_0/N for r = 1, less where α beats equal counts. The
+// estimate stays unbiased because r comes from the pixel's neighbours, not from the
+// pilot it weighs, and is fixed before the stages after it (PooledSelection). A NaN
+// ratio counts as 1.
+double pilotWeight(float varianceRatio, int pilotSamples, int spp);
 
 }  // namespace misalloc

@@ -151,6 +151,8 @@ nlohmann::json renderReport(const RenderRun& run) {
     }
     if (methodTraits(run.method).split == Split::Probed)
       report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
+    else
+      report["allocation"]["pilot_weight_mean"] = r.meanPilotWeight;
     if (run.method == Method::Linear)
       report["allocation"]["zero_weight_rule"] = run.adaptive.linearRule == ZeroWeightRule::MinSampleVariance
                                                      ? "min sample variance ([SS23] eq. 19)"

@@ -106,6 +106,12 @@ int nearestEqual(const WeightGrid& grid) {
   return best;
 }
 
+// A search that keeps no running sums cannot add to those of a search before it.
+void checkRunningSums(bool runningSums, bool added) {
+  if (!runningSums && added)
+    throw std::logic_error("grid search: a second search since reset() on a search that keeps no running sums");
+}
+
 void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, int pixelCount) {
   if (!pooling) return;
   if (rule == GridRule::MaxEntropy) throw std::invalid_argument("grid search: rule (a) cannot pool its selection");
@@ -122,13 +128,15 @@ struct SelectionArrays {
   std::vector<int> selected;
   std::vector<unsigned> fallbacks;
   std::vector<unsigned char> skipped;
+  std::vector<float> varianceRatio;
 };
 
 GridSearchResult toResult(const SelectionArrays& a, int m) {
   const std::size_t pixels = a.selected.size();
   GridSearchResult result;
   result.selected = a.selected;
-  result.skipped = a.skipped.empty() ? std::vector<unsigned char>(pixels, 0) : a.skipped;
+  result.skipped = a.skipped;
+  result.varianceRatio = a.varianceRatio;
   result.allocations.reserve(pixels);
   for (std::size_t p = 0; p < pixels; ++p) {
     const float* weights = &a.alpha[p * m];
@@ -175,10 +183,6 @@ struct SearchSetup {
   int rule;
 };
 
-// Adds g and g² of each technique's new samples to its sums for every combination l
-// ([HS14] Alg. 1 line 8), the sums at `sums` (runningSumIndex) first brought to the current
-// scale: the kernel's loadSums, sumTechnique and storeSums as plain loops, with the
-// same operations in the same order.
 // Adds the new samples to the running sums at `sums` (runningSumIndex) for every
 // combination l, the sums first brought to the current scale: the kernel's loadSums,
 // sumTechnique or sumMixture and storeSums as plain loops, with the same operations in
@@ -316,7 +320,9 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
         fallbacks == 0 ? setup.lanes.alpha[k * setup.lanes.paddedSize + best] : 1.0f / m;
 }
 
-// The pooled score of combination l over window w: the kernel's pooledScore.
+// The pooled score of combination l over window w: Σ_q score_q,l · (scaleMin/scale_q)²
+// over the window's pooled pixels q in row-major order, one fma chain, as a lane of the
+// kernel selectPooled sums it.
 float pooledScore(const std::vector<float>& scores, const std::vector<float>& scales,
                   const std::vector<unsigned>& fallbacks, kern::PoolWindow w, int width, int paddedSize, float scaleMin,
                   int l) {
@@ -324,7 +330,7 @@ float pooledScore(const std::vector<float>& scores, const std::vector<float>& sc
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x) {
       int q = y * width + x;
-      if (fallbacks[q] == 0)
+      if (kern::pools(w, q, fallbacks[q]))
         sum = std::fma(scores[std::size_t(q) * paddedSize + l], kern::poolingFactor(scaleMin, scales[q]), sum);
     }
   return sum;
@@ -340,8 +346,10 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
   float scaleMin = INFINITY;
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x)
-      if (in.fallbacks[y * pooling.width + x] == 0) scaleMin = std::fmin(scaleMin, scales[y * pooling.width + x]);
+      if (kern::pools(w, y * pooling.width + x, in.fallbacks[y * pooling.width + x]))
+        scaleMin = std::fmin(scaleMin, scales[y * pooling.width + x]);
   int best = -1, skipped = 0;
+  float ratio = 1.0f;
   if (scaleMin < INFINITY) {
     float top = -INFINITY;
     for (int l = 0; l < setup.grid.size(); ++l) {
@@ -352,16 +360,17 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
     for (int y = w.y0; y <= w.y1; ++y)
       for (int x = w.x0; x <= w.x1; ++x) {
         int q = y * pooling.width + x;
-        if (in.fallbacks[q] != 0) continue;
+        if (!kern::pools(w, q, in.fallbacks[q])) continue;
         const float* s = scores.data() + std::size_t(q) * padded;
         float d = (s[best] - s[equal]) * kern::poolingFactor(scaleMin, scales[q]);
         sumD += d;
         sumD2 = std::fma(d, d, sumD2);
         count += 1.0f;
       }
-    skipped =
-        kern::skipsAdapting(top, pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal),
-                            float(pooling.minGain), sumD, sumD2, count);
+    float pooledEqual = pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal);
+    skipped = kern::skipsAdapting(top, pooledEqual, float(pooling.minGain), sumD, sumD2, count);
+    if (!skipped && w.self >= 0)
+      ratio = kern::pooledVarianceRatio(top, setup.lanes.cost[best], pooledEqual, setup.lanes.cost[equal]);
   }
   for (int k = 0; k < m; ++k)
     out.alpha[std::size_t(pixel) * m + k] =
@@ -369,11 +378,13 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
   out.selected[pixel] = best < 0 ? in.selected[pixel] : (skipped ? -1 : best);
   out.fallbacks[pixel] = best < 0 ? in.fallbacks[pixel] : 0u;
   out.skipped[pixel] = (unsigned char)skipped;
+  out.varianceRatio[pixel] = ratio;
 }
 
 SelectionArrays selectionArrays(int pixels, int m) {
   return SelectionArrays{std::vector<float>(std::size_t(pixels) * m), std::vector<int>(pixels),
-                         std::vector<unsigned>(pixels), std::vector<unsigned char>(pixels, 0)};
+                         std::vector<unsigned>(pixels), std::vector<unsigned char>(pixels, 0),
+                         std::vector<float>(pixels, 1.0f)};
 }
 
 }  // namespace
@@ -403,9 +414,10 @@ std::size_t StoredSampleLayout::floatCount() const {
   return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
 
-std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize) {
+std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums) {
   const std::size_t scoreFloats = paddedGridSize(gridFor(techniqueCount, gridSize).size()) + 1;  // and the scale
-  return (runningSumFloats(techniqueCount, gridSize) + scoreFloats) * sizeof(float) + sizeof(kern::PixelSummary);
+  const std::size_t sumFloats = runningSums ? runningSumFloats(techniqueCount, gridSize) : 0;
+  return (sumFloats + scoreFloats) * sizeof(float) + sizeof(kern::PixelSummary);
 }
 
 int GridSearchResult::fallbackCount() const {
@@ -413,9 +425,13 @@ int GridSearchResult::fallbackCount() const {
       std::count_if(allocations.begin(), allocations.end(), [](const Allocation& a) { return a.usedFallback(); }));
 }
 
-GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize)
-    : device_(device), techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
-  const std::size_t sumFloats = runningSumFloats(techniqueCount, gridSize);
+GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize, bool runningSums)
+    : device_(device),
+      techniqueCount_(techniqueCount),
+      pixelCount_(pixelCount),
+      gridSize_(gridSize),
+      runningSums_(runningSums) {
+  const std::size_t sumFloats = runningSums ? runningSumFloats(techniqueCount, gridSize) : 1;
   cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(techniqueCount));
   kernel_ = cl::Kernel(program, "gridSearch");
   poolKernel_ = cl::Kernel(program, "selectPooled");
@@ -440,6 +456,7 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
 }
 
 void GridSearch::reset() {
+  added_ = false;
   // An all-zero PixelSummary is emptySummary().
   device_.queue.enqueueFillBuffer(summaries_, cl_uchar(0), 0, summaries_.getInfo<CL_MEM_SIZE>());
   device_.queue.finish();
@@ -450,6 +467,8 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
                                  const std::optional<PooledSelection>& pooling) {
   checkLayout(layout, techniqueCount_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
   checkPooling(pooling, rule, pixelCount_);
+  checkRunningSums(runningSums_, added_);
+  added_ = added_ || layout.taken > 0;
   WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   const int m = techniqueCount_, pixels = layout.pixelCount;
   GridSearchResult result;
@@ -472,7 +491,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
   bindKernelArgs(kernel_, samples, cl_int(layout.capacity), cl_int(layout.taken), cl_int(pixels), gridLanes, gridCost,
                  cl_int(grid.size()), cl_int(lanes.paddedSize), cost, cl_int(kernelRule(rule)), prepared_, summaries_,
-                 sums_, alphaOut, selectedOut, fallbacksOut, scores_, scales_);
+                 sums_, cl_int(runningSums_), alphaOut, selectedOut, fallbacksOut, scores_, scales_);
   cl::Event done;
   const int blocks = int(paddedPixelCount(std::size_t(pixels)) / kPixelBlock);
   device_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange,
@@ -488,10 +507,11 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     selectedFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
     fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
     cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
+    cl::Buffer ratioOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(float));
     bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, cl_int(pooling->width),
-                   cl_int(pooling->height), cl_int(pooling->radius), gridLanes, cl_int(grid.size()),
+                   cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost, cl_int(grid.size()),
                    cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)), cl_float(pooling->minGain), alphaFinal,
-                   selectedFinal, fallbacksFinal, skippedOut);
+                   selectedFinal, fallbacksFinal, skippedOut, ratioOut);
     cl::Event pooled;
     device_.queue.enqueueNDRangeKernel(
         poolKernel_, cl::NullRange,
@@ -500,6 +520,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     pooled.wait();
     result.seconds += eventSeconds(pooled);
     device_.queue.enqueueReadBuffer(skippedOut, CL_FALSE, 0, pixels, out.skipped.data());
+    device_.queue.enqueueReadBuffer(ratioOut, CL_FALSE, 0, pixels * sizeof(float), out.varianceRatio.data());
   }
   device_.queue.enqueueReadBuffer(alphaFinal, CL_FALSE, 0, out.alpha.size() * sizeof(float), out.alpha.data());
   device_.queue.enqueueReadBuffer(selectedFinal, CL_FALSE, 0, pixels * sizeof(cl_int), out.selected.data());
@@ -517,22 +538,28 @@ struct GridSearchReference::RunningSums {
   std::vector<float> scores, scales;  // the last search's, as the kernel keeps them
 };
 
-GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize)
-    : techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize) {
+GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize, bool runningSums)
+    : techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
   running_ = std::make_unique<RunningSums>();
-  running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(techniqueCount, gridSize));
+  if (runningSums)
+    running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(techniqueCount, gridSize));
   reset();
 }
 
 GridSearchReference::~GridSearchReference() = default;
 
-void GridSearchReference::reset() { running_->summaries.assign(std::max(0, pixelCount_), kern::emptySummary()); }
+void GridSearchReference::reset() {
+  added_ = false;
+  running_->summaries.assign(std::max(0, pixelCount_), kern::emptySummary());
+}
 
 GridSearchResult GridSearchReference::run(const std::vector<float>& samples, const StoredSampleLayout& layout,
                                           const std::vector<double>& costs, GridRule rule,
                                           const std::optional<PooledSelection>& pooling) {
   checkLayout(layout, techniqueCount_, pixelCount_, samples.size());
   checkPooling(pooling, rule, pixelCount_);
+  checkRunningSums(runningSums_, added_);
+  added_ = added_ || layout.taken > 0;
   WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
   SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
   const int m = techniqueCount_, pixels = layout.pixelCount, padded = setup.lanes.paddedSize;
@@ -546,10 +573,12 @@ GridSearchResult GridSearchReference::run(const std::vector<float>& samples, con
 #pragma omp parallel
   {
     std::vector<float> prepared(std::size_t(layout.taken) * (m + 1));
+    std::vector<float> scratch(runningSums_ ? 0 : pixelSums);  // the sums of a search that keeps none
 #pragma omp for schedule(dynamic, 16)
     for (int pixel = 0; pixel < pixels; ++pixel)
-      searchPixel(setup, pixel, prepared, running_->summaries[pixel], running_->sums.data() + pixel * pixelSums,
-                  searched, scores.data() + std::size_t(pixel) * padded, scales[pixel]);
+      searchPixel(setup, pixel, prepared, running_->summaries[pixel],
+                  runningSums_ ? running_->sums.data() + pixel * pixelSums : scratch.data(), searched,
+                  scores.data() + std::size_t(pixel) * padded, scales[pixel]);
   }
   SelectionArrays selection = searched;
   if (pooling) {

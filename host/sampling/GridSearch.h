@@ -65,17 +65,20 @@ struct StoredSampleLayout {
 };
 
 // What a search keeps per pixel from run to run: Σ g and Σ g² for every technique and
-// combination (the grid padded to whole passes), the summary of the samples, and the
-// last search's scores and scale for the pooled selection.
-std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize);
+// combination (the grid padded to whole passes) where it keeps running sums, the
+// summary of the samples, and the last search's scores and scale for the pooled
+// selection.
+std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums);
 
 // Rule (b)'s selection over neighbourhoods (stats/Pooling.h says why) and the skip
 // rule, for the pixels of a width × height image: each pixel takes the combination
 // with the least Σ_q (Σ_k c_k α_k) V_q over the ranked pixels q within `radius`, and
 // keeps equal weights where that is not at least the fraction `minGain` below its
 // value at the combination nearest to equal weights: there the predicted gain does
-// not pay for the overhead of adapting. Radius 0 and minGain 0 select as rule (b)
-// alone, but for the skip where no combination beats equal weights.
+// not pay for the overhead of adapting. For radius > 0 the pixel itself is left out
+// of its window, so that its selection and predicted variance ratio do not depend on
+// its own samples. Radius 0 and minGain 0 select as rule (b) alone, but for the skip
+// where no combination beats equal weights.
 struct PooledSelection {
   int width = 0, height = 0;
   int radius = 0;
@@ -86,7 +89,11 @@ struct GridSearchResult {
   std::vector<Allocation> allocations;  // per pixel; equal weights where it fell back or skipped
   std::vector<int> selected;            // l₀ per pixel, −1 where it fell back or skipped
   std::vector<unsigned char> skipped;   // per pixel: 1 where the skip rule kept equal weights
-  double seconds = 0;                   // kernel time (profiling event), or the reference's wall time
+  // Per pixel, V(equal)/V(α) of the multi-sample estimator as the pixel's neighbours
+  // predict it, α the selected weights: 1 where the selection did not come from the
+  // neighbours alone (no pooling, radius 0, no ranked neighbour) or skipped.
+  std::vector<float> varianceRatio;
+  double seconds = 0;  // kernel time (profiling event), or the reference's wall time
 
   int fallbackCount() const;
 };
@@ -95,12 +102,16 @@ struct GridSearchResult {
 // gridSize, ·); the program is built and its first launch compiled once. Each run adds
 // the samples stored since the previous one to every pixel's running sums
 // (gridSearchBytesPerPixel, on the device) and selects by all the samples added so far.
+// Without `runningSums` (a render with one search) nothing is kept, which saves their
+// memory and the search the time of writing them, and a second search with samples
+// since reset() throws std::logic_error.
 // A scratch buffer of taken · (M + 1) floats per pixel, for the new samples as the sums
 // read them, is kept from run to run.
 class GridSearch {
  public:
   // Throws std::invalid_argument for M outside 2..kMaxTechniques or a grid size < 1.
-  GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize);
+  GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize,
+             bool runningSums = true);
 
   // Throws std::invalid_argument for a layout that does not match M, the pixel count
   // or the buffer, taken > capacity, costs that makeWeightGrid rejects, or pooling
@@ -114,6 +125,8 @@ class GridSearch {
  private:
   const Device& device_;
   int techniqueCount_, pixelCount_, gridSize_;
+  bool runningSums_;
+  bool added_ = false;  // a search since reset() added samples
   cl::Kernel kernel_, poolKernel_;
   cl::Buffer summaries_, sums_, prepared_, scores_, scales_;
   std::size_t preparedFloats_ = 0;
@@ -124,7 +137,7 @@ class GridSearch {
 // running sums in host memory.
 class GridSearchReference {
  public:
-  GridSearchReference(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize);
+  GridSearchReference(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true);
   ~GridSearchReference();
 
   GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
@@ -135,6 +148,8 @@ class GridSearchReference {
  private:
   struct RunningSums;  // kernels/gridsearch.h's types, which this header does not include
   int techniqueCount_, pixelCount_, gridSize_;
+  bool runningSums_;
+  bool added_ = false;
   std::unique_ptr<RunningSums> running_;
 };
 

@@ -33,7 +33,8 @@ HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
   share_.name = kHostSamplerName;
   if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
   if (config.gridSize > 0)
-    gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize);
+    gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize,
+                                                        config.runningSums);
 }
 
 void HostSampler::forgetStages() {

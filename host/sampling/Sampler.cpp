@@ -101,7 +101,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
     // A sub-device searches on its whole device, which shares its context and so reads
     // the stored samples where they are: the search is not split into tiles.
     gridSearch_ = std::make_unique<GridSearch>(device.whole ? *device.whole : device, scene.techniqueCount(),
-                                               scene.pixelCount(), config.gridSize);
+                                               scene.pixelCount(), config.gridSize, config.runningSums);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
   StagePlan empty;
@@ -127,13 +127,15 @@ std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range)
   std::vector<int32_t> order(range.size());
   std::iota(order.begin(), order.end(), range.begin);
   const size_t M = size_t(plan.techniqueCount);
-  // A comparison sort: its memory scales with the pixels, where a counting sort's
-  // buckets 0..N took 4 bytes per sample of the stage.
-  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+  auto before = [&](int32_t a, int32_t b) {
     const int* countsA = plan.counts.data() + size_t(a) * M;
     const int* countsB = plan.counts.data() + size_t(b) * M;
     return std::lexicographical_compare(countsA, countsA + M - 1, countsB, countsB + M - 1);
-  });
+  };
+  // A comparison sort: its memory scales with the pixels, where a counting sort's
+  // buckets 0..N took 4 bytes per sample of the stage. Fixed splits and the pilot are
+  // in order already, and a check is cheaper than the sort.
+  if (!std::is_sorted(order.begin(), order.end(), before)) std::stable_sort(order.begin(), order.end(), before);
   return order;
 }
 

@@ -68,6 +68,8 @@ struct SamplerConfig {
   // is stored, up to this many per pixel.
   int sampleCapacity = 0;
   int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
+  // The grid searches keep running sums, for renders that search more than once.
+  bool runningSums = true;
 };
 
 }  // namespace misalloc

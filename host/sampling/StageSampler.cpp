@@ -25,7 +25,8 @@ size_t StageSampler::storedSampleCount() const {
 }
 
 size_t StageSampler::searchBytesPerPixel() const {
-  return config_.gridSize > 0 ? gridSearchBytesPerPixel(scene_.techniqueCount(), config_.gridSize) : 0;
+  return config_.gridSize > 0 ? gridSearchBytesPerPixel(scene_.techniqueCount(), config_.gridSize, config_.runningSums)
+                              : 0;
 }
 
 int StageSampler::takeSlots(const StagePlan& plan) {

@@ -3,8 +3,10 @@
 // The grids of BRDF parameters vary smoothly across the image, as real surfaces do, so
 // neighbouring pixels want nearly the same α, while one pixel's pilot of a few samples
 // per technique misjudges the variance of a small bright source by large factors.
-// Pooling changes only which α a stage uses, never the estimate's weights, so it
-// keeps every stage unbiased.
+// Pooling changes only which α a stage uses, so it keeps every stage unbiased. The grid
+// search's pooled selection also predicts how much better that α is than equal counts,
+// which weighs the pilot (render/Render.h, pilotWeight): it leaves the pixel's own
+// samples out for that (sampling/GridSearch.h, PooledSelection).
 
 #include <vector>
 
