@@ -34,7 +34,8 @@ void AdaptiveArgs::add(CLI::App& command) {
       ->check(integerIn(1, INT_MAX));
   command
       .add_option("--pool", options.poolRadius,
-                  "adaptive methods: allocate from the statistics of the (2R+1)^2 pixels around each pixel")
+                  "adaptive methods: allocate from the statistics of the (2R+1)^2 pixels around each pixel "
+                  "(exact: without the pixel itself, whose pilot is then weighted by the gain its neighbours predict)")
       ->capture_default_str()
       ->check(integerIn(0, 1 << 12));
   command
