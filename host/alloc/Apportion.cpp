@@ -24,11 +24,11 @@ double validatedSum(const double* alpha, int m) {
 
 void apportionCounts(const double* alpha, int m, int total, int* counts) {
   if (total < 0) throw std::invalid_argument("apportionCounts: negative total " + std::to_string(total));
-  double sum = validatedSum(alpha, m);
+  const double sum = validatedSum(alpha, m);
+  auto quota = [&](int k) { return alpha[k] / sum * total; };
   int assigned = 0;
   for (int k = 0; k < m; ++k) {
-    double quota = alpha[k] / sum * total;
-    counts[k] = std::min(static_cast<int>(std::floor(quota)), total - assigned);
+    counts[k] = std::min(static_cast<int>(std::floor(quota(k))), total - assigned);
     assigned += counts[k];
   }
   // Σ ⌊quota⌋ > N − m, so fewer than m techniques receive one more sample: each to the
@@ -38,7 +38,7 @@ void apportionCounts(const double* alpha, int m, int total, int* counts) {
     int next = -1;
     double largest = -1;
     for (int k = 0; k < m; ++k) {
-      double remainder = alpha[k] / sum * total - counts[k];
+      double remainder = quota(k) - counts[k];
       if (!(served >> k & 1u) && remainder > largest) largest = remainder, next = k;
     }
     served |= 1u << next;

@@ -59,7 +59,8 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
 double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator);
 
 // The pilot's weight in the estimate. The stages are independent unbiased estimates,
-// best combined with weights ∝ N_b/V_b. The pilot took N_0 samples at equal counts and
+// best combined with weights ∝ N_b/V_b (inverse-variance weighting, V_b/N_b a stage's
+// variance as [SHS16] eq. 21 gives it). The pilot took N_0 samples at equal counts and
 // the stages after it N − N_0 at α, so with r = V(equal)/V(α) that is
 // N_0 / (N_0 + (N − N_0) r): N_0/N for r = 1, less where α beats equal counts. The
 // estimate stays unbiased because r comes from the pixel's neighbours, not from the

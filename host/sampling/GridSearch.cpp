@@ -431,7 +431,6 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
       pixelCount_(pixelCount),
       gridSize_(gridSize),
       runningSums_(runningSums) {
-  const std::size_t sumFloats = runningSums ? runningSumFloats(techniqueCount, gridSize) : 1;
   cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(techniqueCount));
   kernel_ = cl::Kernel(program, "gridSearch");
   poolKernel_ = cl::Kernel(program, "selectPooled");
@@ -440,7 +439,8 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
   summaries_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(kern::PixelSummary));
   // Only pixels with hasSums read their sums, so reset() leaves them; they are written
   // once here so that the first search does not pay a page fault per 4 KiB of them.
-  const std::size_t sumBytes = pixels * sumFloats * sizeof(float);
+  // Without running sums the kernel reads and writes none: one float stands in.
+  const std::size_t sumBytes = (runningSums ? pixels * runningSumFloats(techniqueCount, gridSize) : 1) * sizeof(float);
   sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
   device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
   const std::size_t scoreBytes = pixels * paddedGridSize(gridFor(techniqueCount, gridSize).size()) * sizeof(float);
