@@ -93,4 +93,15 @@ inline double sidakLevel(double familyLevel, int checks) {
   return -std::expm1(std::log1p(-familyLevel) / checks);
 }
 
+// The bound that a standard normal variable's |z| exceeds with probability `level`:
+// erfc(z/√2) = level, solved by bisection (erfc falls monotonically).
+inline double twoSidedNormalBound(double level) {
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 200; ++i) {
+    double mid = 0.5 * (lo + hi);
+    (std::erfc(mid / std::sqrt(2.0)) > level ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 }  // namespace misalloc::test

@@ -17,7 +17,7 @@
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "compare/EnvmapPdfComparison.h"
-#include "render/BrdfCoverage.h"
+#include "render/RunChecks.h"
 #include "render/Reference.h"
 #include "render/Render.h"
 #include "report/Report.h"
@@ -48,7 +48,7 @@ Rendering renderWith(const Scene& scene, Method method, Estimator estimator, int
   AdaptiveOptions options;
   options.costs.assign(scene.techniqueCount(), 1.0);
   options.oracleSamples = 128;
-  requireBrdfCoverage(scene.options.envmapPdf, scene.techniqueCount(), method, estimator, spp, options);
+  requireValidRun(scene.options, method, estimator, spp, options);
   Sampler sampler(testDevice(), scene, samplerConfigFor(method, estimator, spp, options));
   return render(sampler, method, options, spp, seed);
 }
@@ -150,22 +150,31 @@ TEST_CASE("a compensated pdf that leaves no texel falls back to plain, and the r
 
 TEST_CASE("the compensated pdf refuses schedules that could skip BRDF sampling", "[compensated][bad-input]") {
   const EnvmapPdf plain, compensated = parseEnvmapPdf("compensated");
+  auto scene = [](const EnvmapPdf& pdf, int M) {
+    SceneOptions o;
+    o.envmapPdf = pdf;
+    o.splitBrdf = M == 3;
+    return o;
+  };
   AdaptiveOptions options;
-  CHECK_THROWS_WITH(requireBrdfCoverage(compensated, 2, Method::Envmap, Estimator::MultiSample, 64, options),
+  CHECK_THROWS_WITH(requireValidRun(scene(compensated, 2), Method::Envmap, Estimator::MultiSample, 64, options),
                     Catch::Contains("--method envmap with --envmap-pdf compensated:0.5"));
-  CHECK_NOTHROW(requireBrdfCoverage(plain, 2, Method::Envmap, Estimator::MultiSample, 64, options));
-  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Brdf, Estimator::MultiSample, 1, options));
-  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Equal, Estimator::OneSample, 1, options));
-  CHECK_THROWS_AS(requireBrdfCoverage(compensated, 2, Method::Equal, Estimator::MultiSample, 1, options), InputError);
-  CHECK_THROWS_AS(requireBrdfCoverage(compensated, 3, Method::Oracle, Estimator::MultiSample, 2, options), InputError);
+  CHECK_NOTHROW(requireValidRun(scene(plain, 2), Method::Envmap, Estimator::MultiSample, 64, options));
+  CHECK_NOTHROW(requireValidRun(scene(compensated, 2), Method::Brdf, Estimator::MultiSample, 1, options));
+  // One sample, one-sample MIS: the equal split's probabilities are n_k/N = (1, 0),
+  // envmap sampling alone.
+  CHECK_THROWS_AS(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::OneSample, 1, options), InputError);
+  CHECK_NOTHROW(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::OneSample, 2, options));
+  CHECK_THROWS_AS(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::MultiSample, 1, options), InputError);
+  CHECK_THROWS_AS(requireValidRun(scene(compensated, 3), Method::Oracle, Estimator::MultiSample, 2, options), InputError);
   // 9 spp in 4 stages: a pilot of 4, then stages of 2, 1, 1, 1: the floor cannot give
   // both techniques one.
   AdaptiveOptions fourStages = options;
   fourStages.stages = 4;
-  CHECK_THROWS_WITH(requireBrdfCoverage(compensated, 2, Method::Heuristic, Estimator::MultiSample, 9, fourStages),
+  CHECK_THROWS_WITH(requireValidRun(scene(compensated, 2), Method::Heuristic, Estimator::MultiSample, 9, fourStages),
                     Catch::Contains("a stage of 1 sample(s)"));
-  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Heuristic, Estimator::MultiSample, 12, fourStages));
-  CHECK_NOTHROW(requireBrdfCoverage(compensated, 2, Method::Heuristic, Estimator::MultiSample, 9, options));
+  CHECK_NOTHROW(requireValidRun(scene(compensated, 2), Method::Heuristic, Estimator::MultiSample, 12, fourStages));
+  CHECK_NOTHROW(requireValidRun(scene(compensated, 2), Method::Heuristic, Estimator::MultiSample, 9, options));
 
   TempDir dir("compensated");
   const std::string outputs = fmt::format("--out {} --report {} --reference none", (dir.path / "r.exr").string(),
@@ -249,7 +258,9 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
 
 TEST_CASE("the optimal pdf refuses envmap sampling alone and split BRDF lobes, and reports its bank",
           "[compensated][optimal][bad-input]") {
-  CHECK_THROWS_WITH(requireBrdfCoverage(parseEnvmapPdf("optimal"), 2, Method::Envmap, Estimator::MultiSample, 64, {}),
+  SceneOptions optimal;
+  optimal.envmapPdf = parseEnvmapPdf("optimal");
+  CHECK_THROWS_WITH(requireValidRun(optimal, Method::Envmap, Estimator::MultiSample, 64, {}),
                     Catch::Contains("--method envmap with --envmap-pdf optimal"));
   CHECK_THROWS_WITH(compensatedScene("sun", "seed000", "optimal", EnvmapSampler::Alias, true),
                     Catch::Contains("--envmap-pdf optimal with --split-brdf: not implemented"));

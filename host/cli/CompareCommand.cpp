@@ -26,7 +26,6 @@
 #include "compare/Suite.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
-#include "render/BrdfCoverage.h"
 #include "render/Reference.h"
 
 namespace misalloc {
@@ -87,14 +86,13 @@ int runCompare(CompareArgs& args) {
   compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(args.envmapPdfs));
   compare.methods = parseMethodList(args.methods);
   compare.budgets = parseBudgets(args.budgets);
-  compare.adaptive = args.adaptive.make(compare.cases.front().scene.splitBrdf ? 3 : 2);
+  compare.adaptive = args.adaptive.make(compare.cases.front().scene.techniqueCount());
   compare.device = args.devices.spec();
   validateCompareOptions(compare);
   for (const CompareCase& c : compare.cases)
     for (int budget : compare.budgets)
       requireStatisticsMemory(c.scene, compare.methods, "--budgets", budget, compare.adaptive, args.devices.onHost(),
                               args.devices.samplerCount());
-  requireBrdfCoverage(compare);
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
   OutputSet outputs(envmapInputs(scenes));

@@ -17,10 +17,10 @@
 #include "cli/SceneArgs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
-#include "render/BrdfCoverage.h"
 #include "render/Method.h"
 #include "render/Reference.h"
 #include "render/Render.h"
+#include "render/RunChecks.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "report/Report.h"
@@ -63,13 +63,8 @@ int runRender(RenderArgs& args) {
   }
   Scene scene = args.scene.make();
   AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
-  requireBrdfCoverage(scene.options.envmapPdf, scene.techniqueCount(), m, estimator, args.spp, adaptive);
+  requireValidRun(scene.options, m, estimator, args.spp, adaptive);
   std::string costSource = adaptive.costs.empty() ? "measured" : "--cost";
-  if (traits.split == Split::Staged)
-    stageSizes(adaptive.pilotFraction, adaptive.stages, args.spp, scene.techniqueCount());
-  if (traits.split == Split::Probed && adaptive.oracleSamples < 2 * scene.techniqueCount())
-    throw InputError(
-        fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", adaptive.oracleSamples));
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());

@@ -17,7 +17,7 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
                             const std::string& sppOption, int spp, const AdaptiveOptions& adaptive, bool onHost,
                             int samplers) {
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
-  const double pixels = double(scene.width) * scene.height, M = scene.splitBrdf ? 3 : 2;
+  const double pixels = double(scene.width) * scene.height, M = scene.techniqueCount();
   if (config.sampleCapacity > 0) {
     // A record of M + 2 floats per sample (kernels/stats.h), on a CPU device once in
     // its buffer and once read back; with several devices, once in each device's

@@ -10,6 +10,7 @@
 #include "JsonText.h"
 #include "compare/ProgressMeter.h"
 #include "render/Reference.h"
+#include "render/RunChecks.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "report/PreviewPng.h"
@@ -125,23 +126,9 @@ void validateCompareOptions(const CompareOptions& options) {
       throw InputError("--budgets: list each budget once, in ascending order");
   }
   if (options.repeats < 1) throw InputError(fmt::format("--repeats {}: need at least 1", options.repeats));
-  if (options.adaptive.gridSize < 2)
-    throw InputError(
-        fmt::format("--grid-u {}: the search needs at least 2 weight combinations", options.adaptive.gridSize));
-  for (const CompareCase& c : options.cases) {
-    const int M = c.scene.splitBrdf ? 3 : 2;
-    if (!options.adaptive.costs.empty() && int(options.adaptive.costs.size()) != M)
-      throw InputError(fmt::format("--cost: {} needs {} costs", c.label, M));
-    for (Method m : options.methods) {
-      const MethodTraits& traits = methodTraits(m);
-      if (traits.split == Split::Probed && options.adaptive.oracleSamples < 2 * M)
-        throw InputError(fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique",
-                                     options.adaptive.oracleSamples));
-      if (traits.split == Split::Staged)
-        for (int budget : options.budgets)
-          stageSizes(options.adaptive.pilotFraction, options.adaptive.stages, budget, M);
-    }
-  }
+  for (const CompareCase& c : options.cases)
+    for (Method m : options.methods)
+      for (int budget : options.budgets) requireValidRun(c.scene, m, Estimator::MultiSample, budget, options.adaptive);
 }
 
 Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard) {

@@ -8,7 +8,6 @@
 
 #include "Error.h"
 #include "compare/Suite.h"
-#include "render/BrdfCoverage.h"
 
 namespace misalloc {
 namespace {
@@ -82,14 +81,6 @@ std::vector<CompareCase> casesPerEnvmapPdf(const std::vector<CompareCase>& cases
       out.push_back(withPdf);
     }
   return out;
-}
-
-void requireBrdfCoverage(const CompareOptions& options) {
-  for (const CompareCase& c : options.cases)
-    for (Method m : options.methods)
-      for (int budget : options.budgets)
-        requireBrdfCoverage(c.scene.envmapPdf, c.scene.splitBrdf ? 3 : 2, m, Estimator::MultiSample, budget,
-                            options.adaptive);
 }
 
 TextTable envmapPdfSpeedUpTable(const Summary& s, int budget) {

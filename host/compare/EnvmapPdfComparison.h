@@ -17,8 +17,6 @@ std::vector<EnvmapPdf> parseEnvmapPdfList(const std::string& list);
 // Each case once per pdf, in that order, relabelled with caseLabel.
 std::vector<CompareCase> casesPerEnvmapPdf(const std::vector<CompareCase>& cases, const std::vector<EnvmapPdf>& pdfs);
 
-// requireBrdfCoverage for every case, method and budget (compare's multi-sample stages).
-void requireBrdfCoverage(const CompareOptions& options);
 
 // Rows = (method, pdf), columns = scenes and their geometric mean: the speed-up at equal
 // error at `budget` over `equal` with the plain pdf of the same scene (speedUpOver).

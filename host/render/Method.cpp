@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 
@@ -81,6 +82,9 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
         const PhongParameters& p = scene.grid.pixels[pixel];
         double albedo = p.rhoD + p.rhoS;
         counts[1] = albedo > 0 ? int(std::lround(spp * p.rhoD / albedo)) : spp;
+        // The specular lobe alone does not cover the diffuse lobe; the diffuse lobe
+        // covers both (render/RunChecks.h).
+        if (p.rhoD > 0) counts[1] = std::max(counts[1], 1);
         counts[2] = spp - counts[1];
       }
       break;

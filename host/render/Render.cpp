@@ -11,6 +11,7 @@
 #include "alloc/Apportion.h"
 #include "alloc/HeuristicAllocation.h"
 #include "alloc/SigmaAllocation.h"
+#include "render/RunChecks.h"
 #include "stats/Pooling.h"
 #include "stats/RunningStats.h"
 
@@ -248,27 +249,15 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   return config;
 }
 
-namespace {
-
-void validateAdaptiveOptions(const AdaptiveOptions& options) {
-  if (options.poolRadius < 0)
-    throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
-  if (!(options.minGain >= 0 && options.minGain < 1))
-    throw InputError(fmt::format("--skip-below {}: the gain must lie in [0, 1)", options.minGain));
-  if (options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)
-    throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
-}
-
-}  // namespace
-
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed) {
   auto start = Clock::now();
   const Scene& scene = sampler.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
+  const Estimator estimator = sampler.config().estimator;
+  requireValidRun(scene.options, method, estimator, spp, options);
   sampler.reset();
   Rendering out;
   Progress progress(pixels, M);
-  const Estimator estimator = sampler.config().estimator;
   if (!isAdaptive(method)) {
     TakenStage stage = takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false);
     accumulateStage(progress.totals, stage, estimator, std::vector<double>(pixels, 1.0));
@@ -288,7 +277,6 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     progress = std::move(render);
   } else {
     validateCosts(options.costs, M);
-    validateAdaptiveOptions(options);
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
     if (methodTraits(method).searchesWeights && options.gridRule == GridRule::MinCostVariance)

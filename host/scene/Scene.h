@@ -18,6 +18,9 @@ struct SceneOptions {
   EnvmapSampler sampler = EnvmapSampler::Alias;
   EnvmapPdf envmapPdf;  // [Kar19]: plain, or compensated for MIS with BRDF sampling
   int proceduralWidth = 512;
+
+  // M: envmap sampling and BRDF sampling, or the envmap and each of the BRDF's two lobes.
+  int techniqueCount() const { return splitBrdf ? 3 : 2; }
 };
 
 // Everything the sampling kernel reads, built once per run.
@@ -30,7 +33,7 @@ struct Scene {
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
 
-  int techniqueCount() const { return options.splitBrdf ? 3 : 2; }
+  int techniqueCount() const { return options.techniqueCount(); }
   int pixelCount() const { return grid.width * grid.height; }
   std::vector<std::string> techniqueNames() const;
 };

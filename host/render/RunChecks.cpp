@@ -1,0 +1,115 @@
+#include "render/RunChecks.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "Error.h"
+#include "sampling/Costs.h"
+
+namespace misalloc {
+namespace {
+
+constexpr unsigned kEnvmapTechnique = 1u << 0;
+// The BRDF (M = 2) or its diffuse lobe (M = 3): either covers every direction where the
+// BRDF is non-zero.
+constexpr unsigned kCoveringBrdfTechnique = 1u << 1;
+
+unsigned allTechniques(int M) { return (1u << M) - 1; }
+
+// The techniques a fixed split samples in every pixel that needs them: `envmap` and
+// `brdf` their own, `equal` the first min(spp, M) (methodCounts hands out the remainder
+// from technique 0 on).
+unsigned fixedSplitTechniques(Method method, int M, int spp) {
+  switch (method) {
+    case Method::Envmap:
+      return kEnvmapTechnique;
+    case Method::Brdf:  // with lobes: the diffuse one wherever its albedo is non-zero (methodCounts)
+      return kCoveringBrdfTechnique;
+    default:
+      return allTechniques(std::min(spp, M));
+  }
+}
+
+// An allocated stage of `samples` samples: all techniques once the floor can give each
+// one, else any single technique.
+bool allocatedStageCovers(int samples, int M, const EnvmapPdf& pdf, Estimator estimator) {
+  if (samples >= M) return coversIntegrand(allTechniques(M), M, pdf, estimator);
+  for (int k = 0; k < M; ++k)
+    if (!coversIntegrand(1u << k, M, pdf, estimator)) return false;
+  return true;
+}
+
+std::string biasReason(const EnvmapPdf& pdf, Estimator estimator, int M) {
+  if (estimator == Estimator::CountIndependent)
+    return "the count-independent estimator ([SHS16] eq. 26) needs a sample of every technique in every stage";
+  if (!pdf.plain())
+    return fmt::format("the {} envmap pdf is zero where the radiance is low, so BRDF sampling must take a sample in "
+                       "every stage",
+                       envmapPdfName(pdf));
+  return M == 3 ? "the specular lobe alone misses the diffuse lobe, so every stage needs a sample of each technique"
+                : "every stage needs a sample of each technique";
+}
+
+void requireCoveredStages(const SceneOptions& scene, Method method, Estimator estimator, int spp,
+                          const AdaptiveOptions& options) {
+  const int M = scene.techniqueCount();
+  const EnvmapPdf& pdf = scene.envmapPdf;
+  const MethodTraits& traits = methodTraits(method);
+  if (method == Method::Envmap && !pdf.plain())
+    throw InputError(fmt::format(
+        "--method envmap with --envmap-pdf {}: the pdf is zero where BRDF sampling alone covers the integrand "
+        "(compensated: where the radiance is at or below 2(1-C) times its mean), so envmap sampling alone would "
+        "be biased; use --envmap-pdf plain, or a method that also samples the BRDF",
+        envmapPdfName(pdf)));
+  if (traits.split == Split::Fixed) {
+    if (coversIntegrand(fixedSplitTechniques(method, M, spp), M, pdf, estimator)) return;
+    throw InputError(fmt::format("--spp {} with --method {}{}: the split leaves a technique without samples, and {}; "
+                                 "raise --spp",
+                                 spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf),
+                                 biasReason(pdf, estimator, M)));
+  }
+  std::vector<int> sizes{spp};
+  if (traits.split == Split::Staged) sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
+  const int smallest = *std::min_element(sizes.begin(), sizes.end());
+  if (!allocatedStageCovers(smallest, M, pdf, traits.estimator))
+    throw InputError(fmt::format(
+        "--spp {} with --method {}{}: a stage of {} sample(s) cannot give each of the {} techniques one, and {}; "
+        "raise --spp{}",
+        spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf), smallest, M,
+        biasReason(pdf, traits.estimator, M), traits.split == Split::Staged ? " or lower --stages" : ""));
+}
+
+}  // namespace
+
+bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator) {
+  if (estimator == Estimator::CountIndependent) return sampled == allTechniques(techniqueCount);
+  if (pdf.plain() && (sampled & kEnvmapTechnique)) return true;
+  return (sampled & kCoveringBrdfTechnique) != 0;
+}
+
+void requireValidRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,
+                     const AdaptiveOptions& options) {
+  const MethodTraits& traits = methodTraits(method);
+  const int M = scene.techniqueCount();
+  if (traits.adaptive() && estimator != Estimator::MultiSample && estimator != traits.estimator)
+    throw InputError(fmt::format("--estimator: --method {} takes multi-sample stages", traits.name));
+  if (traits.adaptive() && !options.costs.empty() && int(options.costs.size()) != M)
+    throw InputError(fmt::format("--cost: {} technique(s) need {} costs, not {}", M, M, options.costs.size()));
+  if (traits.split == Split::Probed && options.oracleSamples < 2 * M)
+    throw InputError(
+        fmt::format("--oracle-spp {}: the probe needs at least 2 samples per technique", options.oracleSamples));
+  if (traits.searchesWeights && options.gridSize < 2)
+    throw InputError(fmt::format("--grid-u {}: the search needs at least 2 weight combinations", options.gridSize));
+  if (traits.split == Split::Staged) {
+    if (options.poolRadius < 0)
+      throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
+    if (!(options.minGain >= 0 && options.minGain < 1))
+      throw InputError(fmt::format("--skip-below {}: the gain must lie in [0, 1)", options.minGain));
+    if (traits.searchesWeights && options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)
+      throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
+  }
+  requireCoveredStages(scene, method, estimator, spp, options);
+}
+
+}  // namespace misalloc

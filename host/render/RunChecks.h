@@ -1,0 +1,28 @@
+#pragma once
+// The refusals that the options alone decide, made before any work: a run that would
+// be biased or cannot be carried out is refused with a message naming the options.
+#include "render/Method.h"
+#include "render/Render.h"
+
+namespace misalloc {
+
+// Whether MIS over the techniques in `sampled` (bit k: technique k takes at least one
+// sample of the stage) estimates the integral without bias in every pixel. The balance
+// heuristic needs the sampled techniques' pdfs to cover the integrand ([HS14] eq. 4.1:
+// p_α > 0 wherever f > 0): the plain envmap pdf covers it, a compensated or optimal
+// one does not ([Kar19] Sec. 4: it is zero where the radiance is low); BRDF sampling
+// covers it, and with the BRDF split into lobes the diffuse lobe does, the specular lobe
+// only its own cone. The count-independent weights ([SHS16] eq. 26) give each technique
+// a term that only its own samples estimate: every technique must be sampled.
+bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator);
+
+// Throws InputError, before any work, for a run of `method` on `scene` with `spp`
+// samples per pixel that the options make impossible (a schedule that does not fit the
+// budget, a probe too small, costs of the wrong count, the entropy rule with pooling) or
+// biased: any stage whose counts could leave the sampled techniques short of covering
+// the integrand. Render's floor gives every technique one sample of a stage of at
+// least M samples; a smaller allocated stage may go to any single technique.
+void requireValidRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,
+                     const AdaptiveOptions& options);
+
+}  // namespace misalloc
