@@ -2,25 +2,24 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
+#include <regex>
+#include <set>
 
 #include "Error.h"
+#include "Interruption.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
 namespace {
-
-// A hidden name beside `path` with ".tmp" in it, so that leftovers of a killed run are
-// easy to recognise; `attempt` makes it unique when an earlier one exists.
-std::string temporaryName(const std::string& path, int attempt) {
-  fs::path p(path);
-  return (p.parent_path() / fmt::format(".{}.tmp-{}-{}", p.filename().string(), ::getpid(), attempt)).string();
-}
 
 bool writeAll(int fd, const std::string& content) {
   for (size_t done = 0; done < content.size();) {
@@ -32,9 +31,55 @@ bool writeAll(int fd, const std::string& content) {
   return true;
 }
 
+// The longest file name the folder takes (NAME_MAX of its file system).
+size_t nameLimit(const fs::path& folder) {
+  long limit = ::pathconf(folder.empty() ? "." : folder.c_str(), _PC_NAME_MAX);
+  return limit > 0 ? size_t(limit) : 255;
+}
+
+bool processRuns(long pid) { return ::kill(pid_t(pid), 0) == 0 || errno != ESRCH; }
+
 }  // namespace
 
+std::string temporaryName(const std::string& path, int attempt) {
+  const fs::path p(path);
+  const std::string name = p.filename().string();
+  const std::string suffix = fmt::format(".tmp-{}-{}", ::getpid(), attempt);
+  const size_t limit = nameLimit(p.parent_path());
+  std::string stem = name;
+  if (1 + stem.size() + suffix.size() > limit) {
+    // Keep a prefix to recognise it by and a hash of the whole name to tell apart
+    // targets that share the prefix.
+    const std::string hash = fmt::format("~{:016x}", std::hash<std::string>{}(name));
+    stem = name.substr(0, limit - 1 - suffix.size() - hash.size()) + hash;
+  }
+  return (p.parent_path() / ("." + stem + suffix)).string();
+}
+
+void removeStaleTemporaries(const std::string& folder) {
+  static std::mutex mutex;
+  static std::set<std::string> cleaned;
+  std::error_code ec;
+  const fs::path dir = folder.empty() ? fs::path(".") : fs::path(folder);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!cleaned.insert(fs::absolute(dir, ec).lexically_normal().string()).second) return;
+  }
+  static const std::regex temporary(R"(\..*\.tmp-([0-9]+)-[0-9]+)");
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::smatch match;
+    struct stat info {};
+    if (!std::regex_match(name, match, temporary) || ::lstat(it->path().c_str(), &info) != 0) continue;
+    const long pid = std::stol(match[1].str());
+    if (info.st_uid != ::geteuid() || pid == long(::getpid()) || processRuns(pid)) continue;
+    std::error_code ignored;
+    fs::remove_all(it->path(), ignored);
+  }
+}
+
 std::string writeTemporaryBeside(const std::string& path, const std::string& content) {
+  removeStaleTemporaries(fs::path(path).parent_path().string());
   for (int attempt = 0;; ++attempt) {
     std::string tmp = temporaryName(path, attempt);
     // 0666 and the umask, as for any new file; O_EXCL: an existing file is never touched.
@@ -65,17 +110,27 @@ void renameIntoPlace(const std::string& temporary, const std::string& path) {
 }
 
 void writeFileAtomically(const std::string& path, const std::string& content) {
-  renameIntoPlace(writeTemporaryBeside(path, content), path);
+  const std::string temporary = writeTemporaryBeside(path, content);
+  CriticalSection renaming;
+  renameIntoPlace(temporary, path);
 }
 
 void checkWritableOutput(const std::string& path, const std::string& option) {
+  if (path.empty()) throw InputError(fmt::format("{}: an empty path", option));
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir))
     throw InputError(fmt::format("{} {}: folder {} does not exist", option, path, dir.string()));
   if (::access(dir.c_str(), W_OK) != 0)
     throw InputError(fmt::format("{} {}: folder {} is not writable", option, path, dir.string()));
-  if (fs::is_directory(path)) throw InputError(fmt::format("{} {}: is a folder", option, path));
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status)) throw InputError(fmt::format("{} {}: is a folder", option, path));
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw InputError(fmt::format(
+        "{} {}: is not a regular file (a device, FIFO or socket); outputs are written beside their target and "
+        "renamed over it, which would replace it: give a regular file's path",
+        option, path));
 }
 
 }  // namespace misalloc

@@ -6,7 +6,18 @@ namespace misalloc {
 // Writes `content` to a new file beside `path` (never over an existing one: its name
 // is chosen with O_EXCL) and returns that file's name, so that a caller can rename it
 // over `path` once complete. Throws InputError naming `path`; nothing is left behind.
+// The name is hidden and fits the file system's limit whatever the length of `path`'s
+// (temporaryName).
 std::string writeTemporaryBeside(const std::string& path, const std::string& content);
+
+// A hidden name beside `path` for a temporary file or folder of this process, unique
+// with `attempt`: ".NAME.tmp-PID-ATTEMPT", NAME shortened (and a hash of it added)
+// where the whole would not fit the file system's limit.
+std::string temporaryName(const std::string& path, int attempt);
+
+// Removes what killed runs left in `folder`: temporary files and folders of this user
+// whose process (the PID in their name) no longer runs. Once per folder and process.
+void removeStaleTemporaries(const std::string& folder);
 
 // Renames `temporary` over `path`; on failure removes `temporary` and throws
 // InputError naming `path`.
@@ -16,8 +27,10 @@ void renameIntoPlace(const std::string& temporary, const std::string& path);
 // only when complete: a failure or an interruption never leaves a partial file.
 void writeFileAtomically(const std::string& path, const std::string& content);
 
-// Throws InputError unless `path`'s folder exists and is writable, so that bad
-// output options fail before any work is done.
+// Throws InputError, naming `option`, unless `path` is a regular file or absent and its
+// folder exists and is writable, so that bad output options fail before any work is
+// done. A device, FIFO or socket is refused: outputs are written beside their target
+// and renamed over it, which would replace the special file with a regular one.
 void checkWritableOutput(const std::string& path, const std::string& option);
 
 }  // namespace misalloc

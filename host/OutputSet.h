@@ -18,10 +18,12 @@ bool sameFile(const std::string& a, const std::string& b);
 
 // The outputs of one run, written all or none. Each output is claimed before any work
 // and refused (InputError) if it is the same file as an input or as another output,
-// or its folder is missing or not writable. Its content is then handed over, and
-// commit() writes every file to a temporary beside its target and only when all are
-// complete renames them into place. A run that throws before commit() leaves every
-// existing file as it was, and the destructor removes what it staged.
+// is not a regular file, or its folder is missing or not writable. Its content is then
+// handed over, and commit() writes every file to a temporary beside its target and
+// only when all are complete renames them into place, inside a CriticalSection
+// (Interruption.h): SIGINT and SIGTERM wait for the renames. A run that throws before
+// commit() leaves every existing file as it was, and the destructor removes what it
+// staged; what SIGKILL leaves is removed by the next run that writes there.
 class OutputSet {
  public:
   explicit OutputSet(std::vector<NamedFile> inputs);
@@ -31,10 +33,16 @@ class OutputSet {
 
   void claim(const std::string& option, const std::string& path);
 
-  // Claims a folder that the run fills as it goes (compare's --out-dir): returns a
-  // fresh staging folder to write into; commit() moves its files into `folder`,
-  // creating it if missing, after checking that none of them replaces an input.
-  std::string claimFolder(const std::string& option, const std::string& folder);
+  // An input known only once the run's options are read (the reference cache's entry):
+  // refused like the others if an output is the same file or lies in the claimed folder.
+  void addInput(const NamedFile& input);
+
+  // Claims a folder that the run fills as it goes (compare's --out-dir) and returns a
+  // fresh staging folder beside it to write into; commit() replaces `folder` with it
+  // as a whole, by exchanging the two in one rename. Refused when an input lies inside
+  // `folder`, or when `folder` holds files but not `marker`, the file that says an
+  // earlier run of the same command wrote it: replacing it would delete the user's own.
+  std::string claimFolder(const std::string& option, const std::string& folder, const std::string& marker);
 
   // The content of a claimed file, written at commit().
   void put(const std::string& path, std::string content);
@@ -47,11 +55,12 @@ class OutputSet {
   };
 
   void refuseClashes(const NamedFile& output) const;
-  std::vector<StagedFile> stagedFolderFiles() const;
+  void refuseInputInFolder(const NamedFile& input) const;
+  void replaceFolder();
 
   std::vector<NamedFile> inputs_, outputs_;
   std::map<std::string, std::string> contents_;  // claimed path → content
-  std::string folder_, staging_;                 // claimFolder's target and staging folder
+  std::string folderOption_, folder_, staging_;  // claimFolder's option, target and staging folder
   std::vector<std::string> temporaries_;         // written, not yet renamed
 };
 

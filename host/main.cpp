@@ -27,6 +27,18 @@ void refuseUnknownSubcommand(const CLI::App& app, int argc, char** argv) {
     throw InputError(fmt::format("unknown subcommand '{}'; the subcommands are {}", argv[1], fmt::join(names, ", ")));
 }
 
+// An option given an empty value ("--out ''") names nothing: a path, a list, a name. Refused
+// here, before any work, for every option of every subcommand; leaving an option out
+// is how a default is asked for.
+void refuseEmptyValues(const CLI::App& command) {
+  for (const CLI::Option* option : command.get_options()) {
+    const std::vector<std::string>& values = option->results();
+    if (std::find(values.begin(), values.end(), std::string()) != values.end())
+      throw InputError(fmt::format("{}: an empty value{}", option->get_name(),
+                                   option->get_required() ? "" : "; leave the option out for its default"));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -41,7 +53,10 @@ int main(int argc, char** argv) {
     refuseUnknownSubcommand(app, argc, argv);
     app.parse(argc, argv);
     for (const Subcommand& s : subcommands)
-      if (app.got_subcommand(s.command)) return s.run();
+      if (app.got_subcommand(s.command)) {
+        refuseEmptyValues(*s.command);
+        return s.run();
+      }
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
     std::cerr << "misalloc: error: " << e.what() << "\nRun with --help for more information.\n";

@@ -62,11 +62,13 @@ RgbImage testImage(int width, int height) {
 }
 
 // Writes `planes` (one per name, row 0 first) with OpenEXR directly, as HALF or FLOAT,
-// over the data window (x0, y0)–(x0 + width − 1, y0 + height − 1).
+// over the data window (x0, y0)–(x0 + width − 1, y0 + height − 1), in `display` (the
+// data window if empty).
 void writeRawExr(const std::string& path, int width, int height, const std::vector<std::string>& names,
-                 const std::vector<std::vector<float>>& planes, Imf::PixelType type, int x0 = 0, int y0 = 0) {
+                 const std::vector<std::vector<float>>& planes, Imf::PixelType type, int x0 = 0, int y0 = 0,
+                 Imath::Box2i display = Imath::Box2i()) {
   Imath::Box2i window({x0, y0}, {x0 + width - 1, y0 + height - 1});
-  Imf::Header header(window, window);
+  Imf::Header header(display.isEmpty() ? window : display, window);
   std::vector<std::vector<half>> halves(planes.size());
   Imf::FrameBuffer frame;
   for (std::size_t k = 0; k < names.size(); ++k) {
@@ -119,6 +121,42 @@ TEST_CASE("readExr reads half RGB and RGBA as float, ignores alpha, and honours 
   CHECK(back.width == 6);
   CHECK(back.height == 4);
   CHECK(back.rgb == image.rgb);
+}
+
+TEST_CASE("readExr places the data window in the display window, the texels outside it black", "[exr]") {
+  // The lat-long mapping is the display window's: a map whose data covers part of it is
+  // that part of the sphere, not a smaller sphere.
+  ScratchDir dir("display");
+  struct Case {
+    Imath::Box2i display;
+    int x0, y0, width, height;
+  };
+  const Case cases[] = {
+      {Imath::Box2i({0, 0}, {63, 31}), 5, 3, 32, 16},   // inside
+      {Imath::Box2i({0, 0}, {7, 3}), -2, -1, 12, 6},    // overscan: data beyond the display window
+      {Imath::Box2i({10, 20}, {17, 23}), 12, 21, 3, 2}  // a display window not at the origin
+  };
+  for (const Case& c : cases) {
+    RgbImage data = testImage(c.width, c.height);
+    writeRawExr(dir / "w.exr", c.width, c.height, {"R", "G", "B"}, planesOf(data), Imf::FLOAT, c.x0, c.y0, c.display);
+    RgbImage back = readExr(dir / "w.exr");
+    const int W = c.display.max.x - c.display.min.x + 1, H = c.display.max.y - c.display.min.y + 1;
+    REQUIRE(back.width == W);
+    REQUIRE(back.height == H);
+    int mismatches = 0, inData = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const int dx = x + c.display.min.x - c.x0, dy = y + c.display.min.y - c.y0;
+        const bool covered = dx >= 0 && dx < c.width && dy >= 0 && dy < c.height;
+        inData += covered;
+        for (int ch = 0; ch < 3; ++ch) {
+          const float expected = covered ? data.rgb[3 * (std::size_t(dy) * c.width + dx) + ch] : 0.0f;
+          mismatches += back.rgb[3 * (std::size_t(y) * W + x) + ch] != expected;
+        }
+      }
+    CHECK(inData > 0);
+    CHECK(mismatches == 0);
+  }
 }
 
 TEST_CASE("readExr reads the shipped maps as stats.json describes them", "[exr]") {

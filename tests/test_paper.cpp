@@ -380,10 +380,12 @@ TEST_CASE("[SS23]: the linear heuristic with 100 samples per technique, both Sec
 TEST_CASE("the paper report prints every example and rejects unknown ids", "[paper]") {
   std::ostringstream list;
   listPaperExamples(list);
-  for (const std::string& id : paperExampleIds()) CHECK(list.str().find(id) != std::string::npos);
+  const std::string listed = list.str();
+  for (const std::string& id : paperIds()) CHECK(listed.find("  " + id + " ") != std::string::npos);
+  CHECK(std::count(listed.begin(), listed.end(), '\n') == std::ptrdiff_t(paperIds().size()));
 
   // Printing checks that every published quantity has a computed counterpart.
-  for (const std::string& id : paperExampleIds()) {
+  for (const std::string& id : paperIds()) {
     INFO(id);
     std::ostringstream out;
     REQUIRE_NOTHROW(printPaperExample(id, out));

@@ -9,71 +9,24 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <sstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
+#include "SafetyWorkspace.h"
 #include "JsonText.h"
+#include "RawExr.h"
+#include "paper/PaperReport.h"
 #include "scene/ExrIO.h"
 
 namespace fs = std::filesystem;
 
 using misalloc::test::runMisalloc;
 using misalloc::test::TempDir;
+using namespace misalloc::test;
 
-namespace {
-
-// Every file and link under `dir` with its sha256 (or its link's target), one a line:
-// what a failed run must leave exactly as it was.
-std::string fingerprint(const fs::path& dir) {
-  const std::string command = fmt::format(
-      "cd '{}' && find . -type l -printf '%p -> %l\\n' | sort && find . -type f -print0 | sort -z | xargs -0 -r sha256sum",
-      dir.string());
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string listing;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) listing.append(buffer, n);
-  REQUIRE(pclose(pipe) == 0);
-  return listing;
-}
-
-bool holdsTemporaries(const fs::path& dir) {
-  for (const auto& entry : fs::recursive_directory_iterator(dir))
-    if (entry.path().filename().string().find(".tmp") != std::string::npos) return true;
-  return false;
-}
-
-void writeText(const fs::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-// A small valid envmap, its links, and earlier outputs that a failed run must keep.
-struct Workspace {
-  TempDir dir{"safety"};
-  std::string path(const std::string& name) const { return (dir.path / name).string(); }
-
-  Workspace() {
-    misalloc::writeExr(path("env.exr"), misalloc::RgbImage{8, 4, std::vector<float>(96, 0.5f)});
-    misalloc::writeExr(path("ref.exr"), misalloc::RgbImage{4, 4, std::vector<float>(48, 0.25f)});
-    fs::create_symlink("env.exr", dir.path / "link.exr");
-    fs::create_hard_link(dir.path / "env.exr", dir.path / "hard.exr");
-    fs::create_directory(dir.path / "sub");
-    for (const char* earlier : {"render.exr", "render.json", "alpha.exr", "alpha.png", "ref_out.exr"})
-      writeText(dir.path / earlier, std::string("earlier ") + earlier);
-  }
-
-  // A fast run: a 4×4 image of the small map, no reference unless asked.
-  std::string render(const std::string& args) const {
-    return fmt::format("render --envmap {} --size 4x4 --spp 8 --device cpu --reference none --out {} --report {} {}",
-                       path("env.exr"), path("render.exr"), path("render.json"), args);
-  }
-};
-
-}  // namespace
 
 TEST_CASE("an output that is an input, or another output, is refused and nothing is written", "[cli][safety]") {
   Workspace w;
@@ -143,29 +96,30 @@ TEST_CASE("a run that fails leaves every earlier file as it was", "[cli][safety]
 TEST_CASE("compare's folder is replaced all or nothing", "[cli][safety][compare]") {
   Workspace w;
   const fs::path out = w.dir.path / "cmp";
-  fs::create_directories(out);
-  writeText(out / "runs.json", "earlier runs");
-  fs::create_directory(out / "summary.md");  // a folder where compare's summary goes: it cannot be replaced
-  writeText(out / "summary.md" / "keep", "keep");
-  const std::string before = fingerprint(w.dir.path);
-  auto r = runMisalloc(fmt::format(
+  const std::string compare = fmt::format(
       "compare --envmap {} --size 4x4 --methods equal --budgets 4 --repeats 1 --device cpu --cache-dir {} --out-dir {}",
-      w.path("env.exr"), w.path("cache"), out.string()));
+      w.path("env.exr"), w.path("cache"), out.string());
+  // A folder of the user's, not an earlier comparison: refused, untouched.
+  fs::create_directories(out);
+  writeText(out / "notes.txt", "mine");
+  const std::string before = fingerprint(w.dir.path);
+  auto r = runMisalloc(compare);
   INFO(r.output);
   CHECK(r.exitCode == 2);
-  CHECK(r.output.find("summary.md") != std::string::npos);
-  fs::remove_all(w.dir.path / "cache");
+  CHECK(r.output.find("holds files that no earlier run of this command wrote (no runs.json)") != std::string::npos);
   CHECK(fingerprint(w.dir.path) == before);
-  CHECK_FALSE(holdsTemporaries(w.dir.path));
 
-  fs::remove_all(out / "summary.md");
-  r = runMisalloc(fmt::format(
-      "compare --envmap {} --size 4x4 --methods equal --budgets 4 --repeats 1 --device cpu --cache-dir {} --out-dir {}",
-      w.path("env.exr"), w.path("cache"), out.string()));
+  // An earlier comparison, even one with a folder where a file now goes, is replaced
+  // as a whole: nothing of it stays beside the new files.
+  writeText(out / "runs.json", "earlier runs");
+  fs::create_directory(out / "summary.md");
+  writeText(out / "summary.md" / "keep", "earlier");
+  r = runMisalloc(compare);
   INFO(r.output);
   CHECK(r.exitCode == 0);
   CHECK(readText(out / "runs.json") != "earlier runs");
-  CHECK(fs::exists(out / "summary.md"));
+  CHECK(fs::is_regular_file(out / "summary.md"));
+  CHECK_FALSE(fs::exists(out / "notes.txt"));
   CHECK_FALSE(holdsTemporaries(w.dir.path));
 }
 
@@ -364,4 +318,130 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
       CHECK(r.output.find(o.option) != std::string::npos);
     }
   CHECK_FALSE(fs::exists(w.path("cmp")));
+}
+
+TEST_CASE("the reference cache cannot lie: a clash is refused, a damaged entry is computed again", "[cli][safety][cache]") {
+  Workspace w;
+  const std::string cache = w.path("cache");
+  const std::string run = w.render("--reference auto --reference-spp 16 --cache-dir " + cache);
+  auto first = runMisalloc(run);
+  INFO(first.output);
+  REQUIRE(first.exitCode == 0);
+  const fs::path references = w.dir.path / "cache" / "references";
+  REQUIRE(std::distance(fs::directory_iterator(references), fs::directory_iterator()) == 1);
+  const fs::path entry = fs::directory_iterator(references)->path();
+  const std::string trusted = readText(entry);
+  CHECK(runMisalloc(run).output.find("16 spp (cached)") != std::string::npos);
+
+  // An output over the cached reference, which is an input of the run.
+  const std::string before = fingerprint(w.dir.path);
+  for (const std::string& args :
+       {fmt::format("render --envmap {} --size 4x4 --spp 8 --device cpu --reference-spp 16 --cache-dir {} --out {} "
+                    "--report {}",
+                    w.path("env.exr"), cache, entry.string(), w.path("render.json")),
+        fmt::format("reference --envmap {} --size 4x4 --spp 16 --device cpu --cache-dir {} --out {}", w.path("env.exr"),
+                    cache, entry.string())}) {
+    auto r = runMisalloc(args);
+    INFO(args << "\n" << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find("is the same file as the cached reference") != std::string::npos);
+    CHECK(fingerprint(w.dir.path) == before);
+  }
+
+  // Each damage is reported, the entry computed again and trusted from then on.
+  struct Damage {
+    const char* what;
+    std::function<void()> apply;
+    const char* reported;
+  };
+  const Damage damages[] = {
+      {"a flipped bit", [&] {
+         std::string bytes = trusted;
+         bytes[bytes.size() / 2] ^= 0x10;
+         writeText(entry, bytes);
+       }, "not trusted"},
+      {"truncated", [&] { writeText(entry, trusted.substr(0, trusted.size() / 2)); }, "truncated or corrupt"},
+      {"text", [&] { writeText(entry, "not an image"); }, "not an OpenEXR file"},
+      {"another size", [&] { misalloc::writeExr(entry.string(), misalloc::RgbImage{2, 2, std::vector<float>(12, 1.0f)}); },
+       "has no misalloc.reference"},
+      {"NaN", [&] {
+         misalloc::RgbImage nan{4, 4, std::vector<float>(48, 0.5f)};
+         nan.rgb[5] = std::nanf("");
+         misalloc::test::writeRawExr(entry.string(), nan);
+       }, "NaN"},
+  };
+  for (const Damage& d : damages) {
+    d.apply();
+    auto r = runMisalloc(run);
+    INFO(d.what << "\n" << r.output);
+    CHECK(r.exitCode == 0);
+    CHECK(r.output.find("the cached reference") != std::string::npos);
+    CHECK(r.output.find(d.reported) != std::string::npos);
+    CHECK(r.output.find("computed again") != std::string::npos);
+    CHECK(readText(entry) == trusted);  // the same seed: the same reference, bit for bit
+    CHECK(runMisalloc(run).output.find("16 spp (cached)") != std::string::npos);
+  }
+  CHECK_FALSE(holdsTemporaries(w.dir.path));
+}
+
+TEST_CASE("refusals that the options alone decide come before any work", "[cli][safety][bad-input]") {
+  Workspace w;
+  const fs::path od = w.dir.path / "od", mine = w.dir.path / "mine";
+  fs::create_directories(od);
+  writeText(od / "runs.json", "an earlier comparison");
+  misalloc::writeExr((od / "map.exr").string(), misalloc::RgbImage{8, 4, std::vector<float>(96, 0.5f)});
+  fs::create_directories(mine);
+  writeText(mine / "notes.txt", "mine");
+  const std::string cache = w.path("cache");
+  const std::string compare = fmt::format(
+      "compare --size 4x4 --methods equal --budgets 4 --repeats 1 --device cpu --reference-spp 20000 --cache-dir {}",
+      cache);
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {fmt::format("{} --envmap {} --out-dir {}", compare, (od / "map.exr").string(), od.string()),
+       "lies inside --out-dir"},
+      {fmt::format("{} --envmap {} --out-dir {} --cache-dir {}", compare, w.path("env.exr"), w.path("od2"),
+                   w.path("od2/cache")),
+       "--cache-dir"},
+      {fmt::format("{} --envmap {} --out-dir {}", compare, w.path("env.exr"), mine.string()),
+       "holds files that no earlier run of this command wrote"},
+      {fmt::format("{} --envmap {} --out-dir ''", compare, w.path("env.exr")), "--out-dir: an empty value"},
+      {w.render("--out '' --reference auto --cache-dir " + cache), "--out: an empty value"},
+      {w.render("--report '' --reference auto --cache-dir " + cache), "--report: an empty value"},
+      {w.render("--cache-dir '' --reference auto"), "--cache-dir: an empty value"},
+      {w.render("--device :2 --reference auto --cache-dir " + cache), "--device :2: expected DEVICE:N"},
+      {w.render("--method sigma-sqrt-c --spp 16 --stages 12 --reference auto --cache-dir " + cache),
+       "a stage of 1 sample(s)"},
+      {w.render("--method exact --grid-rule entropy --spp 40 --reference auto --cache-dir " + cache),
+       "give --pool 0"},
+  };
+  const std::string before = fingerprint(w.dir.path);
+  for (const Case& c : cases) {
+    auto r = runMisalloc(c.args);
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    CHECK_FALSE(fs::exists(cache));  // no reference computed, no cache entry written
+    CHECK(fingerprint(w.dir.path) == before);
+  }
+}
+
+TEST_CASE("every example that `misalloc paper` lists runs", "[cli][paper]") {
+  auto list = runMisalloc("paper");
+  REQUIRE(list.exitCode == 0);
+  std::istringstream lines(list.output);
+  int listed = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string id;
+    words >> id;
+    auto r = runMisalloc("paper " + id);
+    INFO(id << "\n" << r.output);
+    CHECK(r.exitCode == 0);
+    ++listed;
+  }
+  CHECK(listed == int(misalloc::paperIds().size()));
+  CHECK(list.output.find("001-6.3") != std::string::npos);
 }

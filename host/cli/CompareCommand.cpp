@@ -95,9 +95,12 @@ int runCompare(CompareArgs& args) {
                               args.devices.samplerCount());
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
-  OutputSet outputs(envmapInputs(scenes));
+  std::vector<NamedFile> inputs = envmapInputs(scenes);
+  inputs.push_back({"--cache-dir", compare.cacheDir});
+  OutputSet outputs(inputs);
   const std::string outDir = compare.outDir;
-  compare.outDir = outputs.claimFolder("--out-dir", outDir);  // filled as it runs, moved in at the end
+  // Filled as it runs, and put in the place of the folder at the end.
+  compare.outDir = outputs.claimFolder("--out-dir", outDir, "runs.json");
   Comparison comparison = runComparison(compare, guard);
   Summary summary = summarize(comparison, compare);
   writeCompareReport(summary, compare.outDir);

@@ -21,7 +21,7 @@ Subcommand addPaperCommand(CLI::App& app) {
               listPaperExamples(std::cout);
               return 0;
             }
-            const std::vector<std::string> ids = paperExampleIds();
+            const std::vector<std::string> ids = paperIds();
             if (std::find(ids.begin(), ids.end(), *id) == ids.end())
               throw InputError(fmt::format("paper {}: unknown example; valid ids: {}", *id, fmt::join(ids, ", ")));
             printPaperExample(*id, std::cout);

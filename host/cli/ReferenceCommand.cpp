@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "OptionRange.h"
+#include "Interruption.h"
 #include "OutputSet.h"
 #include "cli/DeviceArgs.h"
 #include "cli/EnvmapInputs.h"
@@ -26,9 +27,12 @@ struct ReferenceArgs {
 };
 
 int runReference(ReferenceArgs& args) {
+  exitOnInterrupt();
   OutputSet outputs(envmapInputs({args.scene.parsed()}));
   if (!args.out.empty()) outputs.claim("--out", args.out);
   Scene scene = args.scene.make();
+  if (auto cached = referenceCachePath(scene, args.spp, args.cacheDir))
+    outputs.addInput({"the cached reference (--cache-dir)", *cached});
   auto sampler = args.devices.makeSampler(scene, SamplerConfig{}, kDefaultLocalSize);
   auto reference = findReference(*sampler, scene, args.spp, args.cacheDir, true);
   if (!args.out.empty()) outputs.put(args.out, encodeExr(reference->image));

@@ -10,6 +10,7 @@
 #include "Error.h"
 #include "JsonText.h"
 #include "OptionRange.h"
+#include "Interruption.h"
 #include "OutputSet.h"
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
@@ -23,6 +24,7 @@
 #include "render/RunChecks.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
+#include "report/PreviewPng.h"
 #include "report/Report.h"
 #include "sampling/Costs.h"
 #include "scene/ExrIO.h"
@@ -36,6 +38,7 @@ struct RenderArgs {
   DeviceArgs devices;
   int spp = 200, localSize = kDefaultLocalSize, referenceSpp = 16384;
   uint64_t seed = 1;
+  bool noPreview = false;
   std::string method = "exact", estimator = "multi", out = "render.exr", report = "render.json", reference = "auto",
               cacheDir = defaultCacheDir(), alphaMap;
 };
@@ -47,6 +50,7 @@ Estimator parseEstimator(const std::string& name) {
 }
 
 int runRender(RenderArgs& args) {
+  exitOnInterrupt();
   const Method m = parseMethod(args.method);
   const MethodTraits& traits = methodTraits(m);
   const Estimator estimator = parseEstimator(args.estimator);
@@ -57,6 +61,7 @@ int runRender(RenderArgs& args) {
   OutputSet outputs(inputs);
   outputs.claim("--out", args.out);
   outputs.claim("--report", args.report);
+  if (!args.noPreview) outputs.claim("the preview (--no-preview skips it)", previewPath(args.out));
   if (!args.alphaMap.empty()) {
     outputs.claim("--alpha-map", args.alphaMap);
     outputs.claim("--alpha-map", alphaPngPath(args.alphaMap));
@@ -73,6 +78,9 @@ int runRender(RenderArgs& args) {
   // Without statistics: for the reference and for measuring costs.
   std::unique_ptr<StageSampler> plain;
   const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
+  if (args.reference == "auto")
+    if (auto cached = referenceCachePath(plainScene, args.referenceSpp, args.cacheDir))
+      outputs.addInput({"the cached reference (--cache-dir)", *cached});
   auto plainSampler = [&]() -> StageSampler& {
     if (!plain) plain = args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize);
     return *plain;
@@ -88,6 +96,8 @@ int runRender(RenderArgs& args) {
   nlohmann::json report =
       renderReport({scene, m, config.estimator, adaptive, costSource, args.spp, args.seed, deviceName, r, reference});
   outputs.put(args.out, encodeExr(r.image));
+  if (!args.noPreview)
+    outputs.put(previewPath(args.out), encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));
   if (!args.alphaMap.empty()) {
     AlphaMapFiles alpha = encodeAlphaMaps(scene, r);
     outputs.put(args.alphaMap, std::move(alpha.exr));
@@ -102,9 +112,9 @@ int runRender(RenderArgs& args) {
     std::cout << fmt::format("RMSE x1000 {:.3f}, relative MSE {:.4g} (reference: {})\n",
                              report["rmse_x1000"].get<double>(), report["relative_mse"].get<double>(),
                              reference->source);
-  std::cout << fmt::format(
-      "wrote {} and {}{}\n", args.out, args.report,
-      args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
+  std::cout << fmt::format("wrote {}{}, {}{}\n", args.out, args.noPreview ? "" : ", " + previewPath(args.out),
+                           args.report,
+                           args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
   return 0;
 }
 
@@ -116,7 +126,7 @@ Subcommand addRenderCommand(CLI::App& app) {
   args->scene.add(*command);
   args->scene.addEnvmapPdf(*command);
   command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
-  command->add_option("--method", args->method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear or exact")
+  command->add_option("--method", args->method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear, exact or oracle")
       ->capture_default_str();
   args->adaptive.add(*command);
   command->add_option("--alpha-map", args->alphaMap,
@@ -129,6 +139,7 @@ Subcommand addRenderCommand(CLI::App& app) {
                     "(device D in N sub-devices)");
   command->add_option("--out", args->out, "output EXR")->capture_default_str();
   command->add_option("--report", args->report, "output JSON report")->capture_default_str();
+  command->add_flag("--no-preview", args->noPreview, "write no PNG preview beside the EXR (--out with .png)");
   command
       ->add_option("--reference", args->reference,
                    "auto (analytic, cached, or computed and cached), none, or an EXR path")

@@ -105,8 +105,6 @@ void writeRuns(const std::string& outDir, const Comparison& comparison) {
 
 }  // namespace
 
-std::string previewPath(const std::string& exrPath) { return fs::path(exrPath).replace_extension(".png").string(); }
-
 std::string imagePath(const std::string& caseLabel, Method method, int budget) {
   return runStem(caseLabel, method, budget) + ".exr";
 }

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "compare/Interruption.h"
+#include "Interruption.h"
 #include "render/Method.h"
 #include "render/Render.h"
 #include "scene/Scene.h"
@@ -81,7 +81,5 @@ void validateCompareOptions(const CompareOptions& options);
 // The file names of a case's repeat-0 outputs, relative to outDir.
 std::string imagePath(const std::string& caseLabel, Method method, int budget);  // .exr; .png beside
 std::string alphaMapPath(const std::string& caseLabel, Method method, int budget);
-// The sRGB preview written beside an EXR: the same path with .png.
-std::string previewPath(const std::string& exrPath);
 
 }  // namespace misalloc

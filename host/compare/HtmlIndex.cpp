@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "compare/SummaryTables.h"
+#include "report/PreviewPng.h"
 
 namespace misalloc {
 namespace {

@@ -288,9 +288,15 @@ std::map<std::string, std::string> reproducedValues(const std::string& id) {
   return id.compare(0, 3, "002") == 0 ? values002(n) : values003(n);
 }
 
+std::vector<std::string> paperIds() {
+  std::vector<std::string> ids = paperExampleIds();
+  ids.push_back(kFlatlandId);
+  return ids;
+}
+
 void listPaperExamples(std::ostream& out) {
-  for (const std::string& id : paperExampleIds()) out << fmt::format("  {:<7} {}\n", id, paperExample(id).title());
-  out << fmt::format("  {:<7} {}\n", kFlatlandId, kFlatlandTitle);
+  for (const std::string& id : paperIds())
+    out << fmt::format("  {:<7} {}\n", id, id == kFlatlandId ? kFlatlandTitle : paperExample(id).title());
 }
 
 void printPaperExample(const std::string& id, std::ostream& out) {

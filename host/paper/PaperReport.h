@@ -4,10 +4,15 @@
 #include <iosfwd>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "paper/PaperExamples.h"
 
 namespace misalloc {
+
+// Every id that `misalloc paper` lists and prints: the 1D examples (paperExampleIds),
+// then [Kar19]'s flatland test.
+std::vector<std::string> paperIds();
 
 // One line per example: its id and what it integrates.
 void listPaperExamples(std::ostream& out);

@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
+
+#include "AtomicFile.h"
 
 #include "Error.h"
 #include "render/Method.h"
@@ -43,7 +46,8 @@ std::optional<RgbImage> analyticReference(const Scene& scene) {
   return image;
 }
 
-RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed) {
+RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
+                         const std::function<void(int done, int spp)>& progress) {
   constexpr int maxStage = 4096;
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
   std::vector<double> sum(size_t(pixels) * 3, 0.0);
@@ -58,6 +62,7 @@ RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uin
     // the average unbiased and gives every sample the same weight.
     for (size_t i = 0; i < sum.size(); ++i) sum[i] += stage.rgb[i] * n / spp;
     done += n;
+    if (progress) progress(done, spp);
   }
   RgbImage image;
   image.width = scene.grid.width;
@@ -91,22 +96,85 @@ std::string defaultCacheDir() {
   return ".cache/misalloc";
 }
 
+std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir) {
+  if (analyticReference(scene)) return std::nullopt;
+  return (fs::path(cacheDir) / "references" / (referenceKey(scene, spp) + ".exr")).string();
+}
+
+namespace {
+
+constexpr const char* kReferenceEstimator = "equal-count MIS, plain envmap pdf";
+
+uint64_t pixelChecksum(const RgbImage& image) {
+  Fnv1a h;
+  h.add(image.rgb.data(), image.rgb.size() * sizeof(float));
+  return h.h;
+}
+
+// What a cache entry says it is; the checksum is of its pixels as read.
+ExrAttributes cacheClaims(const Scene& scene, int spp, const RgbImage& image) {
+  return {{"misalloc.reference.key", referenceKey(scene, spp)},
+          {"misalloc.reference.estimator", kReferenceEstimator},
+          {"misalloc.reference.spp", std::to_string(spp)},
+          {"misalloc.reference.size", fmt::format("{}x{}", scene.grid.width, scene.grid.height)},
+          {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(image))}};
+}
+
+// The cached image, or why it cannot be trusted.
+struct CacheEntry {
+  std::optional<RgbImage> image;
+  std::string problem;
+};
+
+CacheEntry readCacheEntry(const std::string& path, const Scene& scene, int spp) {
+  ExrAttributes found;
+  RgbImage image;
+  try {
+    image = readExr(path, nullptr, &found);
+  } catch (const InputError& e) {
+    return {std::nullopt, e.what()};
+  }
+  for (const auto& [name, expected] : cacheClaims(scene, spp, image)) {
+    auto it = found.find(name);
+    if (it == found.end()) return {std::nullopt, fmt::format("it has no {}", name)};
+    if (it->second != expected)
+      return {std::nullopt, fmt::format("its {} is {}, not {}", name, it->second, expected)};
+  }
+  return {std::move(image), ""};
+}
+
+void reportProgress(int done, int spp) {
+  std::cerr << fmt::format("misalloc: reference {}/{} spp\n", done, spp) << std::flush;
+}
+
+}  // namespace
+
 std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
                                        bool computeIfMissing) {
   if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic ([HS14] eq. 6.17)", ""};
-  fs::path path = fs::path(cacheDir) / "references" / (referenceKey(scene, spp) + ".exr");
-  std::string source = fmt::format("equal-count MIS, {} spp", spp);
-  if (fs::exists(path)) return Reference{readExr(path.string()), source + " (cached)", path.string()};
-  if (!computeIfMissing) return std::nullopt;
-  // A seed of its own (top bit set), so a render with a small seed is independent of it.
-  RgbImage image = sampleReference(sampler, scene, spp, 0x8000000000005eedull);
+  const std::string path = *referenceCachePath(scene, spp, cacheDir);
+  const std::string source = fmt::format("{}, {} spp", kReferenceEstimator, spp);
+  std::string recomputed;
   std::error_code ec;
-  fs::create_directories(path.parent_path(), ec);
+  if (fs::exists(path, ec)) {
+    CacheEntry entry = readCacheEntry(path, scene, spp);
+    if (entry.image) return Reference{std::move(*entry.image), source + " (cached)", path};
+    std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; {}\n", path,
+                             entry.problem, computeIfMissing ? "computing it again" : "ignoring it");
+    recomputed = fmt::format(" (computed again: the cached entry was not trusted: {})", entry.problem);
+  }
+  if (!computeIfMissing) return std::nullopt;
+  fs::create_directories(fs::path(path).parent_path(), ec);
   if (ec)
-    throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, path.parent_path().string(),
+    throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, fs::path(path).parent_path().string(),
                                  ec.message()));
-  writeExr(path.string(), image);
-  return Reference{image, source, path.string()};
+  std::cerr << fmt::format("misalloc: computing the reference ({}, {} spp, {}x{} pixels) once; it is cached in {}\n",
+                           kReferenceEstimator, spp, scene.grid.width, scene.grid.height,
+                           fs::path(path).parent_path().string());
+  // A seed of its own (top bit set), so a render with a small seed is independent of it.
+  RgbImage image = sampleReference(sampler, scene, spp, 0x8000000000005eedull, reportProgress);
+  writeFileAtomically(path, encodeExr(image, cacheClaims(scene, spp, image)));
+  return Reference{image, source + recomputed, path};
 }
 
 }  // namespace misalloc

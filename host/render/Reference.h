@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -19,8 +20,10 @@ struct Reference {
 std::optional<RgbImage> analyticReference(const Scene& scene);
 
 // A converged image: equal-count MIS with `spp` samples per pixel, taken in stages of
-// at most 4096 so that no kernel launch runs for long.
-RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed);
+// at most 4096 so that no kernel launch runs for long. `progress`, if given, hears the
+// samples done after each stage.
+RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
+                         const std::function<void(int done, int spp)>& progress = {});
 
 // The cache key of a scene's reference: everything the pixel values depend on (the
 // envmap's texels, the analytic exponent, the grid, size and view) and the spp, not
@@ -30,8 +33,18 @@ std::string referenceKey(const Scene& scene, int spp);
 // $MISALLOC_CACHE_DIR, else $XDG_CACHE_HOME/misalloc, else ~/.cache/misalloc.
 std::string defaultCacheDir();
 
+// The file that caches the scene's sampled reference, read and written by
+// findReference; none for a scene with an analytic one. An input of the run: no
+// output may be written over it.
+std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir);
+
 // The analytic reference if there is one, else the cached one, else (when
-// `computeIfMissing`) a sampled one, which is then cached.
+// `computeIfMissing`) a sampled one, which is then cached. A cache entry carries in
+// its header what it claims to be (the scene's key, the estimator, spp, size) and a
+// checksum of its pixels; one that cannot be read, or whose claims or checksum do not
+// match, is never trusted: it is reported on stderr and in the source, and computed
+// again (or, without `computeIfMissing`, treated as missing). Progress of a computation
+// goes to stderr.
 std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
                                        bool computeIfMissing);
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+
+#include "AtomicFile.h"
 
 #include "scene/PngIO.h"
 
@@ -25,13 +28,21 @@ double previewExposure(const RgbImage& reference) {
   return 1 / double(*p99);
 }
 
-void writePreviewPng(const std::string& path, const RgbImage& image, double exposure) {
+std::string encodePreviewPng(const RgbImage& image, double exposure) {
   std::vector<uint8_t> rgb(image.rgb.size());
   for (size_t i = 0; i < rgb.size(); ++i) {
     double v = std::isfinite(image.rgb[i]) ? std::clamp(exposure * image.rgb[i], 0.0, 1.0) : 1.0;
     rgb[i] = uint8_t(std::lround(255 * srgbEncode(v)));
   }
-  writePng(path, image.width, image.height, rgb);
+  return encodePng(image.width, image.height, rgb);
+}
+
+void writePreviewPng(const std::string& path, const RgbImage& image, double exposure) {
+  writeFileAtomically(path, encodePreviewPng(image, exposure));
+}
+
+std::string previewPath(const std::string& exrPath) {
+  return std::filesystem::path(exrPath).replace_extension(".png").string();
 }
 
 }  // namespace misalloc

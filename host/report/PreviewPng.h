@@ -9,7 +9,12 @@ namespace misalloc {
 // previews of one scene share an exposure and their noise can be compared by eye.
 double previewExposure(const RgbImage& reference);
 
-// An 8-bit sRGB preview of a linear image scaled by `exposure`, clipped to [0, 1].
+// The PNG bytes of an 8-bit sRGB preview of a linear image scaled by `exposure`,
+// clipped to [0, 1].
+std::string encodePreviewPng(const RgbImage& image, double exposure);
 void writePreviewPng(const std::string& path, const RgbImage& image, double exposure);
+
+// The preview's file beside an EXR: the same name with .png.
+std::string previewPath(const std::string& exrPath);
 
 }  // namespace misalloc

@@ -87,8 +87,8 @@ std::pair<std::string, int> subDeviceEntry(const std::string& entry) {
     count = std::stoi(countText, &used);
   } catch (const std::exception&) {
   }
-  if (used != countText.size() || count < 1)
-    throw InputError(fmt::format("--device {}: expected DEVICE:N with N ≥ 1 sub-devices", entry));
+  if (used != countText.size() || count < 1 || colon == 0)
+    throw InputError(fmt::format("--device {}: expected DEVICE:N, a device and N ≥ 1 sub-devices", entry));
   return {entry.substr(0, colon), count};
 }
 

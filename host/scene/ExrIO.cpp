@@ -6,9 +6,11 @@
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <ImfTestFile.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -24,6 +26,8 @@ namespace misalloc {
 namespace {
 
 constexpr char kRgbNames[3] = {'R', 'G', 'B'};
+// OpenEXR's own bound on a window's side, which keeps widths and products in range.
+constexpr int kMaxWindowSide = 1 << 28;
 
 TexelLocation locationOf(std::size_t valueIndex, int width) {
   std::size_t pixel = valueIndex / 3;
@@ -58,18 +62,44 @@ void requireRgbChannels(const Imf::Header& header, const std::string& path) {
   }
 }
 
-RgbImage readRgbPixels(const std::string& path) {
+int widthOf(const Imath::Box2i& box) { return box.max.x - box.min.x + 1; }
+int heightOf(const Imath::Box2i& box) { return box.max.y - box.min.y + 1; }
+
+RgbImage blankImage(const Imath::Box2i& window, const std::string& path) {
+  RgbImage image;
+  image.width = widthOf(window);
+  image.height = heightOf(window);
+  requireHostMemory(fmt::format("'{}' ({}×{} texels × 12 B)", path, image.width, image.height),
+                    double(image.width) * image.height * 3 * sizeof(float));
+  image.rgb.assign(std::size_t(image.width) * std::size_t(image.height) * 3, 0.0f);
+  return image;
+}
+
+// The data window's texels that lie in the display window, at their place in it.
+RgbImage placeInDisplayWindow(const RgbImage& data, const Imath::Box2i& dataWindow, const Imath::Box2i& display,
+                              const std::string& path) {
+  RgbImage image = blankImage(display, path);
+  const int x0 = std::max(dataWindow.min.x, display.min.x), x1 = std::min(dataWindow.max.x, display.max.x);
+  for (int y = std::max(dataWindow.min.y, display.min.y); y <= std::min(dataWindow.max.y, display.max.y); ++y)
+    for (int x = x0; x <= x1; ++x)
+      for (int c = 0; c < 3; ++c)
+        image.rgb[3 * (std::size_t(y - display.min.y) * image.width + std::size_t(x - display.min.x)) + c] =
+            data.rgb[3 * (std::size_t(y - dataWindow.min.y) * data.width + std::size_t(x - dataWindow.min.x)) + c];
+  return image;
+}
+
+RgbImage readRgbPixels(const std::string& path, ExrAttributes* attributes) {
   // The constructor rejects an empty or overflowing data window ("Invalid data
   // window in image header"), so its width and height fit an int and are ≥ 1.
   Imf::InputFile file(path.c_str());
-  requireRgbChannels(file.header(), path);
-  const Imath::Box2i& window = file.header().dataWindow();
-  RgbImage image;
-  image.width = window.max.x - window.min.x + 1;
-  image.height = window.max.y - window.min.y + 1;
-  requireHostMemory(fmt::format("'{}' ({}×{} texels × 12 B)", path, image.width, image.height),
-                    double(image.width) * image.height * 3 * sizeof(float));
-  image.rgb.resize(std::size_t(image.width) * std::size_t(image.height) * 3);
+  const Imf::Header& header = file.header();
+  requireRgbChannels(header, path);
+  const Imath::Box2i& window = header.dataWindow();
+  const Imath::Box2i& display = header.displayWindow();
+  if (widthOf(display) < 1 || heightOf(display) < 1 || widthOf(display) > kMaxWindowSide ||
+      heightOf(display) > kMaxWindowSide)
+    throw InputError(fmt::format("'{}': its display window is empty or too large", path));
+  RgbImage image = blankImage(window, path);
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
   for (int c = 0; c < 3; ++c)
@@ -77,7 +107,11 @@ RgbImage readRgbPixels(const std::string& path) {
                                                                 pixelBytes * std::size_t(image.width)));
   file.setFrameBuffer(frame);
   file.readPixels(window.min.y, window.max.y);
-  return image;
+  if (attributes)
+    for (auto a = header.begin(); a != header.end(); ++a)
+      if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&a.attribute()))
+        (*attributes)[a.name()] = text->value();
+  return window == display ? image : placeInDisplayWindow(image, window, display, path);
 }
 
 void rejectNonFinite(const RgbImage& image, const std::string& path) {
@@ -152,11 +186,11 @@ std::string toString(const TexelLocation& location) {
   return fmt::format("x={}, y={}, channel {}", location.x, location.y, location.channel);
 }
 
-RgbImage readExr(const std::string& path, ReadWarnings* warnings) {
+RgbImage readExr(const std::string& path, ReadWarnings* warnings, ExrAttributes* attributes) {
   requireOpenExrFile(path);
   RgbImage image;
   try {
-    image = readRgbPixels(path);
+    image = readRgbPixels(path, attributes);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {  // Iex::BaseExc for truncated or corrupt files
@@ -167,11 +201,12 @@ RgbImage readExr(const std::string& path, ReadWarnings* warnings) {
   return image;
 }
 
-std::string encodeExr(const RgbImage& image) {
+std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes) {
   if (image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(
         fmt::format("RgbImage {}×{} holds {} floats, not 3 per pixel", image.width, image.height, image.rgb.size()));
   Imf::Header header = floatHeader(image.width, image.height, {"R", "G", "B"});
+  for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
   for (int c = 0; c < 3; ++c)

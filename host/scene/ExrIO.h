@@ -1,6 +1,7 @@
 #pragma once
 // Reading and writing scanline OpenEXR images as 32-bit float channels.
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,16 +29,22 @@ struct ReadWarnings {
   TexelLocation firstNegative;  // meaningful when negativeValues > 0
 };
 
-// Reads the R, G and B channels of `path` as float, whatever their stored type
-// (half, float or uint); an alpha or any other channel is ignored. Throws InputError,
-// naming the file, if it is missing, not an OpenEXR file, truncated or corrupt,
-// lacks R, G or B, has an empty data window, or holds NaN or infinite values.
-RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr);
+// String attributes of an EXR header, by name: what a file says about itself.
+using ExrAttributes = std::map<std::string, std::string>;
 
-// The bytes of an OpenEXR file of float R, G, B with ZIP compression. Both encoders
-// refuse (std::runtime_error) values that are NaN or infinite: a written image is
-// always finite.
-std::string encodeExr(const RgbImage& image);
+// Reads the R, G and B channels of `path` as float, whatever their stored type
+// (half, float or uint); an alpha or any other channel is ignored. The image is the
+// display window, the rectangle the file's pixels stand for (for an envmap, the whole
+// sphere): its texels outside the data window are black, and data outside it is
+// left out. Throws InputError, naming the file, if it is missing, not an OpenEXR file,
+// truncated or corrupt, lacks R, G or B, has an empty window, or holds NaN or infinite
+// values. `attributes`, if given, receives the header's string attributes.
+RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr, ExrAttributes* attributes = nullptr);
+
+// The bytes of an OpenEXR file of float R, G, B with ZIP compression, with `attributes`
+// in its header. Both encoders refuse (std::runtime_error) values that are NaN or
+// infinite: a written image is always finite.
+std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes = {});
 
 // Writes encodeExr's bytes through writeFileAtomically, so a failure (InputError)
 // never leaves a partial file or damages an existing one.
