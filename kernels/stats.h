@@ -48,8 +48,9 @@ MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
 // pixels for float16 loads: value q of the pixel's sample in slot i is at
 // ((block·capacity + i)(M + 2) + q)·16 + lane, with q = 0 the technique, 1 the
 // luminance f, 2 + l the pdf p_l.
+#define MA_SAMPLE_RECORD_FLOATS(techniqueCount) ((techniqueCount) + 2)
 MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int techniqueCount) {
-  return (((pixel / 16) * capacity + i) * (techniqueCount + 2) + q) * 16 + pixel % 16;
+  return (((pixel / 16) * capacity + i) * MA_SAMPLE_RECORD_FLOATS(techniqueCount) + q) * 16 + pixel % 16;
 }
 
 #endif

@@ -54,8 +54,6 @@ int runRender(RenderArgs& args) {
   const Method m = parseMethod(args.method);
   const MethodTraits& traits = methodTraits(m);
   const Estimator estimator = parseEstimator(args.estimator);
-  if (traits.adaptive() && estimator != Estimator::MultiSample)
-    throw InputError(fmt::format("--estimator {}: the adaptive methods take multi-sample stages", args.estimator));
   std::vector<NamedFile> inputs = envmapInputs({args.scene.parsed()});
   if (args.reference != "auto" && args.reference != "none") inputs.push_back({"--reference", args.reference});
   OutputSet outputs(inputs);
@@ -73,24 +71,25 @@ int runRender(RenderArgs& args) {
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
+  const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
+  std::optional<Reference> reference;
+  if (args.reference == "auto") {
+    if (auto cached = referenceCachePath(plainScene, args.referenceSpp, args.cacheDir))
+      outputs.addInput({"the cached reference (--cache-dir)", *cached});
+  } else if (args.reference != "none") {
+    reference = Reference{readExr(args.reference), "file", args.reference};
+    checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
+  }
   auto sampler = args.devices.makeSampler(scene, config, args.localSize);
   std::string deviceName = args.devices.name();
   // Without statistics: for the reference and for measuring costs.
   std::unique_ptr<StageSampler> plain;
-  const Scene plainScene = withPlainEnvmapPdf(scene);  // [Kar19]: the reference's pdf is plain
-  if (args.reference == "auto")
-    if (auto cached = referenceCachePath(plainScene, args.referenceSpp, args.cacheDir))
-      outputs.addInput({"the cached reference (--cache-dir)", *cached});
   auto plainSampler = [&]() -> StageSampler& {
     if (!plain) plain = args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize);
     return *plain;
   };
-  std::optional<Reference> reference;
   if (args.reference == "auto")
     reference = findReference(plainSampler(), plainScene, args.referenceSpp, args.cacheDir, true);
-  else if (args.reference != "none")
-    reference = Reference{readExr(args.reference), "file", args.reference};
-  if (reference) checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
   if (traits.adaptive() && adaptive.costs.empty()) adaptive.costs = measureCosts(plainSampler());
   Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);
   nlohmann::json report =

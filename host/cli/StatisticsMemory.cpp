@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "KernelCode.h"
 #include "MemoryBudget.h"
 
 namespace misalloc {
@@ -19,15 +20,16 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
   const double pixels = double(scene.width) * scene.height, M = scene.techniqueCount();
   if (config.sampleCapacity > 0) {
-    // A record of M + 2 floats per sample (kernels/stats.h), on a CPU device once in
-    // its buffer and once read back; with several devices, once in each device's
-    // buffer, once gathered on the host and once read back.
+    // A record per sample (kernels/stats.h), on a CPU device once in its buffer and
+    // once read back; with several devices, once in each device's buffer, once
+    // gathered on the host and once read back.
     const int copies = samplers > 1 ? samplers + 2 : 2;
-    const double perPixel = double(config.sampleCapacity) * (M + 2) * sizeof(float) * copies;
+    const double recordBytes = MA_SAMPLE_RECORD_FLOATS(scene.techniqueCount()) * sizeof(float);
+    const double perPixel = double(config.sampleCapacity) * recordBytes * copies;
     std::string option = fmt::format("{} {}", sppOption, spp);
     if (methodTraits(m).split == Split::Probed) option += fmt::format(" and --oracle-spp {}", adaptive.oracleSamples);
     needs.push_back({fmt::format("{} with --method {} ({:g} pixels × {} stored samples × {:g} B)", option,
-                                 methodName(m), pixels, config.sampleCapacity, (M + 2) * sizeof(float) * copies),
+                                 methodName(m), pixels, config.sampleCapacity, recordBytes * copies),
                      pixels * perPixel});
   }
   if (config.gridSize > 0) {
