@@ -33,12 +33,15 @@ int runReference(ReferenceArgs& args) {
   Scene scene = args.scene.make();
   if (auto cached = referenceCachePath(scene, args.spp, args.cacheDir))
     outputs.addInput({"the cached reference (--cache-dir)", *cached});
-  auto sampler = args.devices.makeSampler(scene, SamplerConfig{}, kDefaultLocalSize);
-  auto reference = findReference(*sampler, scene, args.spp, args.cacheDir, true);
-  if (!args.out.empty()) outputs.put(args.out, encodeExr(reference->image));
+  std::unique_ptr<StageSampler> sampler;
+  Reference reference = findReference(scene, args.spp, args.cacheDir, [&]() -> StageSampler& {
+    sampler = args.devices.makeSampler(scene, SamplerConfig{}, kDefaultLocalSize);
+    return *sampler;
+  });
+  if (!args.out.empty()) outputs.put(args.out, encodeExr(reference.image));
   outputs.commit();
-  std::cout << fmt::format("reference: {}{}\n", reference->source,
-                           reference->path.empty() ? "" : " at " + reference->path);
+  std::cout << fmt::format("reference: {}{}\n", reference.source,
+                           reference.path.empty() ? "" : " at " + reference.path);
   return 0;
 }
 

@@ -22,11 +22,11 @@
 #include "render/Reference.h"
 #include "render/Render.h"
 #include "render/RunChecks.h"
+#include "render/SceneBasis.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "report/PreviewPng.h"
 #include "report/Report.h"
-#include "sampling/Costs.h"
 #include "scene/ExrIO.h"
 
 namespace misalloc {
@@ -67,7 +67,6 @@ int runRender(RenderArgs& args) {
   Scene scene = args.scene.make();
   AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
   requireValidRun(scene.options, m, estimator, args.spp, adaptive);
-  std::string costSource = adaptive.costs.empty() ? "measured" : "--cost";
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
@@ -82,18 +81,14 @@ int runRender(RenderArgs& args) {
   }
   auto sampler = args.devices.makeSampler(scene, config, args.localSize);
   std::string deviceName = args.devices.name();
-  // Without statistics: for the reference and for measuring costs.
-  std::unique_ptr<StageSampler> plain;
-  auto plainSampler = [&]() -> StageSampler& {
-    if (!plain) plain = args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize);
-    return *plain;
-  };
-  if (args.reference == "auto")
-    reference = findReference(plainSampler(), plainScene, args.referenceSpp, args.cacheDir, true);
-  if (traits.adaptive() && adaptive.costs.empty()) adaptive.costs = measureCosts(plainSampler());
+  SceneBasis basis = findSceneBasis(
+      plainScene, {args.reference == "auto", args.referenceSpp, args.cacheDir, traits.adaptive(), adaptive.costs},
+      [&] { return args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize); });
+  if (basis.reference) reference = std::move(basis.reference);
+  adaptive.costs = basis.costs;
   Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);
   nlohmann::json report =
-      renderReport({scene, m, config.estimator, adaptive, costSource, args.spp, args.seed, deviceName, r, reference});
+      renderReport({scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});
   outputs.put(args.out, encodeExr(r.image));
   if (!args.noPreview)
     outputs.put(previewPath(args.out), encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));

@@ -11,11 +11,12 @@
 #include "compare/ProgressMeter.h"
 #include "render/Reference.h"
 #include "render/RunChecks.h"
+#include "render/SceneBasis.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "report/PreviewPng.h"
+#include "report/RunSummary.h"
 #include "report/Report.h"
-#include "sampling/Costs.h"
 #include "sampling/SamplerChoice.h"
 
 namespace misalloc {
@@ -38,16 +39,13 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.kernelSeconds = r.kernelSeconds;
   rec.allocationSeconds = r.allocationSeconds;
   rec.hostSeconds = r.hostSeconds;
-  double e = rmse(r.image, reference);
-  rec.mse = e * e;
-  rec.relativeMse = relativeMse(r.image, reference);
-  const size_t M = info.techniques.size(), pixels = r.alpha.size() / M;
-  rec.meanAlpha.assign(M, 0.0);
-  for (size_t p = 0; p < pixels; ++p)
-    for (size_t k = 0; k < M; ++k) rec.meanAlpha[k] += r.alpha[p * M + k] / double(pixels);
-  rec.fallbackFraction = double(r.fallbackPixels) / double(pixels);
-  rec.flooredFraction = double(r.flooredPixels) / double(pixels);
-  rec.skippedFraction = double(r.skippedPixels) / double(pixels);
+  RunSummary s = summarizeRun(r, int(info.techniques.size()), &reference);
+  rec.mse = *s.mse;
+  rec.relativeMse = *s.relativeMse;
+  rec.meanAlpha = std::move(s.meanAlpha);
+  rec.fallbackFraction = s.fallbackFraction;
+  rec.flooredFraction = s.flooredFraction;
+  rec.skippedFraction = s.skippedFraction;
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
   return rec;
 }
@@ -140,16 +138,16 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     fs::create_directories(fs::path(options.outDir) / c.label);
     // The reference and the costs with the plain envmap pdf ([Kar19]: withPlainEnvmapPdf).
     const Scene plainScene = withPlainEnvmapPdf(scene);
-    auto plain = devices.makeSampler(plainScene, SamplerConfig{}, options.localSize);
     meter.note(
         fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
-    std::optional<Reference> reference =
-        findReference(*plain, plainScene, options.referenceSpp, options.cacheDir, true);
+    SceneBasis basis = findSceneBasis(
+        plainScene, {true, options.referenceSpp, options.cacheDir, true, options.adaptive.costs},
+        [&] { return devices.makeSampler(plainScene, SamplerConfig{}, options.localSize); });
+    const std::optional<Reference>& reference = basis.reference;
     AdaptiveOptions adaptive = options.adaptive;
-    bool measured = adaptive.costs.empty();
-    if (measured) adaptive.costs = measureCosts(*plain);
-    out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs,
-                         measured ? "measured" : "--cost", reference->source, devices.name()});
+    adaptive.costs = basis.costs;
+    out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
+                         reference->source, devices.name()});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);

@@ -149,8 +149,8 @@ void reportProgress(int done, int spp) {
 
 }  // namespace
 
-std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
-                                       bool computeIfMissing) {
+Reference findReference(const Scene& scene, int spp, const std::string& cacheDir,
+                        const std::function<StageSampler&()>& sampler) {
   if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic ([HS14] eq. 6.17)", ""};
   const std::string path = *referenceCachePath(scene, spp, cacheDir);
   const std::string source = fmt::format("{}, {} spp", kReferenceEstimator, spp);
@@ -159,11 +159,10 @@ std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene
   if (fs::exists(path, ec)) {
     CacheEntry entry = readCacheEntry(path, scene, spp);
     if (entry.image) return Reference{std::move(*entry.image), source + " (cached)", path};
-    std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; {}\n", path,
-                             entry.problem, computeIfMissing ? "computing it again" : "ignoring it");
+    std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; computing it again\n",
+                             path, entry.problem);
     recomputed = fmt::format(" (computed again: the cached entry was not trusted: {})", entry.problem);
   }
-  if (!computeIfMissing) return std::nullopt;
   fs::create_directories(fs::path(path).parent_path(), ec);
   if (ec)
     throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, fs::path(path).parent_path().string(),
@@ -172,7 +171,7 @@ std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene
                            kReferenceEstimator, spp, scene.grid.width, scene.grid.height,
                            fs::path(path).parent_path().string());
   // A seed of its own (top bit set), so a render with a small seed is independent of it.
-  RgbImage image = sampleReference(sampler, scene, spp, 0x8000000000005eedull, reportProgress);
+  RgbImage image = sampleReference(sampler(), scene, spp, 0x8000000000005eedull, reportProgress);
   writeFileAtomically(path, encodeExr(image, cacheClaims(scene, spp, image)));
   return Reference{image, source + recomputed, path};
 }

@@ -38,14 +38,13 @@ std::string defaultCacheDir();
 // output may be written over it.
 std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir);
 
-// The analytic reference if there is one, else the cached one, else (when
-// `computeIfMissing`) a sampled one, which is then cached. A cache entry carries in
-// its header what it claims to be (the scene's key, the estimator, spp, size) and a
-// checksum of its pixels; one that cannot be read, or whose claims or checksum do not
-// match, is never trusted: it is reported on stderr and in the source, and computed
-// again (or, without `computeIfMissing`, treated as missing). Progress of a computation
-// goes to stderr.
-std::optional<Reference> findReference(StageSampler& sampler, const Scene& scene, int spp, const std::string& cacheDir,
-                                       bool computeIfMissing);
+// The analytic reference if there is one, else the cached one, else a sampled one,
+// which is then cached; `sampler` (without statistics) is asked for only then. A cache
+// entry carries in its header what it claims to be (the scene's key, the estimator,
+// spp, size) and a checksum of its pixels; one that cannot be read, or whose claims or
+// checksum do not match, is never trusted: it is reported on stderr and in the source,
+// and computed again. Progress of a computation goes to stderr.
+Reference findReference(const Scene& scene, int spp, const std::string& cacheDir,
+                        const std::function<StageSampler&()>& sampler);
 
 }  // namespace misalloc

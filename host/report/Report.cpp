@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "report/ImageMetrics.h"
+#include "report/RunSummary.h"
 
 namespace misalloc {
 
@@ -100,13 +100,10 @@ nlohmann::json renderReport(const RenderRun& run) {
   double meanVariance = 0;
   for (double v : r.variance) meanVariance += v;
   meanVariance /= pixels;
+  const RunSummary summary = summarizeRun(r, M, run.reference ? &run.reference->image : nullptr);
   nlohmann::json meanAlpha;
   auto names = run.scene.techniqueNames();
-  for (int k = 0; k < M; ++k) {
-    double sum = 0;
-    for (int p = 0; p < pixels; ++p) sum += r.alpha[size_t(p) * M + k];
-    meanAlpha[names[k]] = sum / pixels;
-  }
+  for (int k = 0; k < M; ++k) meanAlpha[names[k]] = summary.meanAlpha[k];
   nlohmann::json report = {
       {"scene", sceneJson(run.scene)},
       {"method", methodName(run.method)},
@@ -136,11 +133,11 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"costs_s_per_sample", costs},
         {"costs_source", run.costSource},
         {"fallback_pixels", r.fallbackPixels},
-        {"fallback_pixel_fraction", double(r.fallbackPixels) / pixels},
+        {"fallback_pixel_fraction", summary.fallbackFraction},
         {"floored_pixels", r.flooredPixels},
-        {"floored_pixel_fraction", double(r.flooredPixels) / pixels},
+        {"floored_pixel_fraction", summary.flooredFraction},
         {"skipped_pixels", r.skippedPixels},
-        {"skipped_pixel_fraction", double(r.skippedPixels) / pixels},
+        {"skipped_pixel_fraction", summary.skippedFraction},
     };
     if (methodTraits(run.method).searchesWeights) {
       report["allocation"]["grid_u"] = run.adaptive.gridSize;
@@ -160,8 +157,8 @@ nlohmann::json renderReport(const RenderRun& run) {
   }
   if (run.reference) {
     report["reference"] = {{"source", run.reference->source}, {"path", run.reference->path}};
-    report["rmse_x1000"] = 1000 * rmse(r.image, run.reference->image);
-    report["relative_mse"] = relativeMse(r.image, run.reference->image);
+    report["rmse_x1000"] = 1000 * std::sqrt(*summary.mse);
+    report["relative_mse"] = *summary.relativeMse;
   } else {
     report["reference"] = nullptr;
   }

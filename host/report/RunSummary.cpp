@@ -1,0 +1,24 @@
+#include "report/RunSummary.h"
+
+#include "report/ImageMetrics.h"
+
+namespace misalloc {
+
+RunSummary summarizeRun(const Rendering& r, int techniqueCount, const RgbImage* reference) {
+  const size_t M = size_t(techniqueCount), pixels = r.alpha.size() / M;
+  RunSummary s;
+  s.meanAlpha.assign(M, 0.0);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t k = 0; k < M; ++k) s.meanAlpha[k] += r.alpha[p * M + k] / double(pixels);
+  s.fallbackFraction = double(r.fallbackPixels) / double(pixels);
+  s.flooredFraction = double(r.flooredPixels) / double(pixels);
+  s.skippedFraction = double(r.skippedPixels) / double(pixels);
+  if (reference) {
+    const double e = rmse(r.image, *reference);
+    s.mse = e * e;
+    s.relativeMse = relativeMse(r.image, *reference);
+  }
+  return s;
+}
+
+}  // namespace misalloc

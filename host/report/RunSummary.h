@@ -1,0 +1,21 @@
+#pragma once
+// What every report of one render says of it (render's JSON report, compare's runs),
+// computed in one place.
+#include <optional>
+#include <vector>
+
+#include "render/Render.h"
+
+namespace misalloc {
+
+struct RunSummary {
+  std::vector<double> meanAlpha;  // per technique: its share of the samples, mean over pixels
+  double fallbackFraction = 0;    // pixels where an allocation rule fell back
+  double flooredFraction = 0;     // pixels whose counts the floor raised to one per technique
+  double skippedFraction = 0;     // pixels the skip rule kept at equal weights
+  std::optional<double> mse, relativeMse;  // against the reference, where there is one
+};
+
+RunSummary summarizeRun(const Rendering& rendering, int techniqueCount, const RgbImage* reference);
+
+}  // namespace misalloc
