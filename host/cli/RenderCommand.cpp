@@ -76,7 +76,7 @@ int runRender(RenderArgs& args) {
     if (auto cached = referenceCachePath(plainScene, args.referenceSpp, args.cacheDir))
       outputs.addInput({"the cached reference (--cache-dir)", *cached});
   } else if (args.reference != "none") {
-    reference = Reference{readExr(args.reference), "file", args.reference};
+    reference = Reference{readExr(args.reference), {}, "file", args.reference};
     checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
   }
   auto sampler = args.devices.makeSampler(scene, config, args.localSize);

@@ -28,7 +28,7 @@ std::string runStem(const std::string& caseLabel, Method method, int budget) {
 }
 
 RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat, uint64_t seed, const Rendering& r,
-                    const RgbImage& reference) {
+                    const Reference& reference) {
   RunRecord rec;
   rec.caseLabel = info.label;
   rec.method = method;
@@ -40,7 +40,9 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.allocationSeconds = r.allocationSeconds;
   rec.hostSeconds = r.hostSeconds;
   RunSummary s = summarizeRun(r, int(info.techniques.size()), &reference);
-  rec.mse = *s.mse;
+  rec.mse = s.corrected->mse;
+  rec.mseStandardError = s.corrected->standardError;
+  rec.rawMse = *s.mse;
   rec.relativeMse = *s.relativeMse;
   rec.meanAlpha = std::move(s.meanAlpha);
   rec.fallbackFraction = s.fallbackFraction;
@@ -57,7 +59,10 @@ nlohmann::json runJson(const RunRecord& r) {
           {"repeat", r.repeat},
           {"seed", r.seed},
           {"time_s", timeSplitJson(r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds)},
-          {"rmse_x1000", 1000 * std::sqrt(r.mse)},
+          {"rmse_x1000", 1000 * std::sqrt(r.rawMse)},
+          {"rmse_x1000_corrected", 1000 * std::sqrt(std::max(0.0, r.mse))},
+          {"mse_corrected", r.mse},
+          {"mse_corrected_standard_error", r.mseStandardError},
           {"relative_mse", r.relativeMse},
           {"efficiency", r.efficiency()},
           {"mean_alpha", r.meanAlpha},
@@ -79,14 +84,15 @@ nlohmann::json caseJson(const CaseInfo& c) {
 
 std::string runsCsv(const Comparison& comparison) {
   std::string csv =
-      "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,relative_mse,efficiency,"
+      "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,mse_corrected,"
+      "mse_corrected_standard_error,relative_mse,efficiency,"
       "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,skipped_pixel_fraction,"
       "statistics_bytes_per_pixel\n";
   for (const RunRecord& r : comparison.runs)
     csv += fmt::format(
-        "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", r.caseLabel,
-        methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds, r.allocationSeconds,
-        r.hostSeconds, 1000 * std::sqrt(r.mse), r.relativeMse, r.efficiency(), r.meanAlpha.front(), r.fallbackFraction,
+        "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+        r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
+        r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.rawMse), r.mse, r.mseStandardError, r.relativeMse, r.efficiency(), r.meanAlpha.front(), r.fallbackFraction,
         r.flooredFraction, r.skippedFraction, r.statisticsBytesPerPixel);
   return csv;
 }
@@ -170,7 +176,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
           }
           const uint64_t seed = options.seed + uint64_t(r);
           Rendering rendering = render(*samplers[m], method, adaptive, budget, seed);
-          out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference->image));
+          out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, *reference));
           if (r == 0) {
             std::string image = options.outDir + "/" + imagePath(c.label, method, budget);
             writeExr(image, rendering.image);

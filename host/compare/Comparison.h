@@ -40,7 +40,10 @@ struct RunRecord {
   int repeat = 0;
   uint64_t seed = 0;
   double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;
-  double mse = 0, relativeMse = 0;
+  // Against the reference: `mse` corrected for the reference's own variance (what every
+  // table, curve and speed-up uses; one repeat's may be below 0), with its standard
+  // error, and the raw MSE.
+  double mse = 0, mseStandardError = 0, rawMse = 0, relativeMse = 0;
   std::vector<double> meanAlpha;  // per technique
   double fallbackFraction = 0;    // pixels where an allocation rule fell back
   double flooredFraction = 0;     // pixels whose counts were raised to one per technique

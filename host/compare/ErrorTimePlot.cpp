@@ -77,7 +77,7 @@ std::string axes(const LogAxis& x, const LogAxis& y) {
   svg += fmt::format(R"(<text x="{}" y="{}" text-anchor="middle" font-size="13">wall time per render (s)</text>)",
                      (kLeft + kWidth - kRight) / 2, kHeight - 12);
   svg += fmt::format(
-      R"svg(<text x="16" y="{0}" text-anchor="middle" font-size="13" transform="rotate(-90 16 {0})">RMSE×1000</text>)svg",
+      R"svg(<text x="16" y="{0}" text-anchor="middle" font-size="13" transform="rotate(-90 16 {0})">RMSE×1000 (reference-corrected)</text>)svg",
       (kTop + kHeight - kBottom) / 2);
   return svg;
 }

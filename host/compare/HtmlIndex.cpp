@@ -61,7 +61,7 @@ std::string indexHtml(const Summary& s) {
     out += fmt::format(
         "<p class=\"note\">Device: {}. Budgets (spp): {}. Times are wall-clock seconds per render "
         "(sampling kernels, allocation and host work), the median over repeats. Errors are against each "
-        "scene's reference; "
+        "scene's reference, corrected for its own variance (the mean of (x − r)² minus Var(r)); "
         "the spread is the standard deviation over repeats with independent seeds.</p>\n",
         s.cases.front().info.device, fmt::join(s.budgets, ", "));
   out += fmt::format("<h2>RMSE×1000 at {} spp ([HS14] Table 5.2 layout)</h2>\n", s.tableBudget) + html(rmseTable(s));

@@ -30,7 +30,7 @@ BudgetStats reduceRepeats(const std::vector<const RunRecord*>& runs) {
     allocation.push_back(r->allocationSeconds);
     host.push_back(r->hostSeconds);
     for (size_t k = 0; k < s.meanAlpha.size(); ++k) s.meanAlpha[k] += r->meanAlpha[k];
-    double rmse = 1000 * std::sqrt(r->mse);
+    double rmse = 1000 * std::sqrt(std::max(0.0, r->mse));
     sumRmse += rmse;
     sumRmse2 += rmse * rmse;
   }
@@ -42,7 +42,7 @@ BudgetStats reduceRepeats(const std::vector<const RunRecord*>& runs) {
   s.kernelSeconds = median(kernel);
   s.allocationSeconds = median(allocation);
   s.hostSeconds = median(host);
-  s.rmseX1000 = 1000 * std::sqrt(s.mse);
+  s.rmseX1000 = 1000 * std::sqrt(std::max(0.0, s.mse));
   s.rmseSpreadX1000 = n > 1 ? std::sqrt(std::max(0.0, (sumRmse2 - sumRmse * sumRmse / n) / (n - 1))) : 0;
   s.efficiency = 1 / (s.mse * s.wallSeconds);
   return s;

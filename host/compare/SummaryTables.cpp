@@ -168,8 +168,10 @@ std::string summaryMarkdown(const Summary& s) {
         first->info.device, fmt::join(s.budgets, ", "), repeats);
   }
   out += fmt::format(
-      "## RMSE×1000 at {} spp\n\nThe layout of [HS14] Table 5.2: the RMSE of RGB over the image against the reference, "
-      "×1000, as the mean over repeats ± their spread (sample standard deviation). Bold: the best of the column.\n\n",
+      "## RMSE×1000 at {} spp\n\nThe layout of [HS14] Table 5.2: the RMSE of RGB over the image against the true "
+      "image, ×1000, as the mean over repeats ± their spread (sample standard deviation). Every error, speed-up and "
+      "equal-time figure here is reference-corrected: the mean of (x − r)² minus the reference's own variance "
+      "(runs.csv also has the raw error). Bold: the best of the column.\n\n",
       s.tableBudget);
   out += markdown(rmseTable(s));
   for (int budget : speedUpBudgets(s)) {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -46,29 +48,43 @@ std::optional<RgbImage> analyticReference(const Scene& scene) {
   return image;
 }
 
-RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
-                         const std::function<void(int done, int spp)>& progress) {
-  constexpr int maxStage = 4096;
+SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
+                                 const std::function<void(int done, int spp)>& progress) {
+  constexpr int kMaxBatch = 4096, kBatches = 16;
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
-  std::vector<double> sum(size_t(pixels) * 3, 0.0);
-  StagePlan plan = singleStagePlan(scene, Method::Equal, std::min(spp, maxStage));
-  for (int done = 0; done < spp;) {
-    int n = std::min(maxStage, spp - done);
-    if (n != plan.stageSamples) plan = singleStagePlan(scene, Method::Equal, n);
-    for (int p = 0; p < pixels; ++p)
-      for (int k = 0; k < M; ++k) plan.firstIndex[size_t(p) * M + k] = uint32_t(done / M + (k < done % M ? 1 : 0));
-    StageResult stage = sampler.run(plan, seed);
-    // Each stage is an unbiased estimate; weighting by its share of the samples keeps
-    // the average unbiased and gives every sample the same weight.
-    for (size_t i = 0; i < sum.size(); ++i) sum[i] += stage.rgb[i] * n / spp;
+  if (spp < 2 * M)
+    throw InputError(fmt::format("--reference-spp {}: a sampled reference needs two batches of {} samples, one per "
+                                 "technique each, to estimate its own variance",
+                                 spp, M));
+  const int batches = std::max(std::min(kBatches, spp / M), (spp + kMaxBatch - 1) / kMaxBatch);
+  // Per pixel and channel: Σ_b n_b x_b and Σ_b n_b x_b² over the batches' estimates x_b.
+  std::vector<double> sum(size_t(pixels) * 3, 0.0), sumSquares(sum.size(), 0.0);
+  std::vector<uint32_t> taken(size_t(pixels) * M, 0);
+  for (int b = 0, done = 0; b < batches; ++b) {
+    const int n = spp / batches + (b < spp % batches ? 1 : 0);
+    StagePlan plan = singleStagePlan(scene, Method::Equal, n);
+    plan.firstIndex = taken;  // each batch takes samples of its own: independent estimates
+    for (size_t i = 0; i < taken.size(); ++i) taken[i] += uint32_t(plan.counts[i]);
+    StageResult batch = sampler.run(plan, seed);
+    for (size_t i = 0; i < sum.size(); ++i) {
+      sum[i] += double(n) * batch.rgb[i];
+      sumSquares[i] += double(n) * batch.rgb[i] * batch.rgb[i];
+    }
     done += n;
     if (progress) progress(done, spp);
   }
-  RgbImage image;
-  image.width = scene.grid.width;
-  image.height = scene.grid.height;
-  image.rgb.assign(sum.begin(), sum.end());
-  return image;
+  // The batches are independent unbiased estimates; weighting each by its share of the
+  // samples gives every sample the same weight. With σ² a sample's variance,
+  // Σ_b n_b (x_b − x̄)² / (B − 1) estimates σ², and the mean's variance is σ²/N.
+  SampledReference out{RgbImage{scene.grid.width, scene.grid.height, std::vector<float>(sum.size())},
+                       std::vector<float>(sum.size())};
+  for (size_t i = 0; i < sum.size(); ++i) {
+    const double mean = sum[i] / spp;
+    out.image.rgb[i] = float(mean);
+    out.standardError[i] =
+        float(std::sqrt(std::max(0.0, sumSquares[i] - spp * mean * mean) / ((batches - 1) * double(spp))));
+  }
+  return out;
 }
 
 std::string referenceKey(const Scene& scene, int spp) {
@@ -105,42 +121,65 @@ namespace {
 
 constexpr const char* kReferenceEstimator = "equal-count MIS, plain envmap pdf";
 
-uint64_t pixelChecksum(const RgbImage& image) {
+// The cache entry's channels: the image, then the standard deviation of its error.
+const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_error.G", "standard_error.B"};
+
+uint64_t pixelChecksum(const SampledReference& reference) {
   Fnv1a h;
-  h.add(image.rgb.data(), image.rgb.size() * sizeof(float));
+  h.add(reference.image.rgb.data(), reference.image.rgb.size() * sizeof(float));
+  h.add(reference.standardError.data(), reference.standardError.size() * sizeof(float));
   return h.h;
 }
 
 // What a cache entry says it is; the checksum is of its pixels as read.
-ExrAttributes cacheClaims(const Scene& scene, int spp, const RgbImage& image) {
+ExrAttributes cacheClaims(const Scene& scene, int spp, const SampledReference& reference) {
   return {{"misalloc.reference.key", referenceKey(scene, spp)},
           {"misalloc.reference.estimator", kReferenceEstimator},
           {"misalloc.reference.spp", std::to_string(spp)},
           {"misalloc.reference.size", fmt::format("{}x{}", scene.grid.width, scene.grid.height)},
-          {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(image))}};
+          {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(reference))}};
 }
 
-// The cached image, or why it cannot be trusted.
+std::string encodeCacheEntry(const Scene& scene, int spp, const SampledReference& reference) {
+  std::vector<std::vector<float>> planes(6, std::vector<float>(reference.standardError.size() / 3));
+  for (size_t p = 0; p < planes[0].size(); ++p)
+    for (int c = 0; c < 3; ++c) {
+      planes[c][p] = reference.image.rgb[3 * p + c];
+      planes[3 + c][p] = reference.standardError[3 * p + c];
+    }
+  std::vector<std::string> names{"R", "G", "B"};
+  names.insert(names.end(), kErrorChannels.begin(), kErrorChannels.end());
+  return encodeExrChannels(reference.image.width, reference.image.height, names, planes,
+                           cacheClaims(scene, spp, reference));
+}
+
+// The cached reference, or why it cannot be trusted.
 struct CacheEntry {
-  std::optional<RgbImage> image;
+  std::optional<SampledReference> reference;
   std::string problem;
 };
 
 CacheEntry readCacheEntry(const std::string& path, const Scene& scene, int spp) {
   ExrAttributes found;
-  RgbImage image;
+  SampledReference entry;
   try {
-    image = readExr(path, nullptr, &found);
+    entry.image = readExr(path, nullptr, &found);
+    std::vector<std::vector<float>> errors = readExrChannels(path, kErrorChannels);
+    entry.standardError.resize(entry.image.rgb.size());
+    if (errors[0].size() * 3 != entry.standardError.size())
+      return {std::nullopt, "its standard error is of another size"};
+    for (size_t p = 0; p < errors[0].size(); ++p)
+      for (int c = 0; c < 3; ++c) entry.standardError[3 * p + c] = errors[c][p];
   } catch (const InputError& e) {
     return {std::nullopt, e.what()};
   }
-  for (const auto& [name, expected] : cacheClaims(scene, spp, image)) {
+  for (const auto& [name, expected] : cacheClaims(scene, spp, entry)) {
     auto it = found.find(name);
     if (it == found.end()) return {std::nullopt, fmt::format("it has no {}", name)};
     if (it->second != expected)
       return {std::nullopt, fmt::format("its {} is {}, not {}", name, it->second, expected)};
   }
-  return {std::move(image), ""};
+  return {std::move(entry), ""};
 }
 
 void reportProgress(int done, int spp) {
@@ -151,14 +190,16 @@ void reportProgress(int done, int spp) {
 
 Reference findReference(const Scene& scene, int spp, const std::string& cacheDir,
                         const std::function<StageSampler&()>& sampler) {
-  if (auto analytic = analyticReference(scene)) return Reference{*analytic, "analytic ([HS14] eq. 6.17)", ""};
+  if (auto analytic = analyticReference(scene)) return Reference{*analytic, {}, "analytic ([HS14] eq. 6.17)", ""};
   const std::string path = *referenceCachePath(scene, spp, cacheDir);
   const std::string source = fmt::format("{}, {} spp", kReferenceEstimator, spp);
   std::string recomputed;
   std::error_code ec;
   if (fs::exists(path, ec)) {
     CacheEntry entry = readCacheEntry(path, scene, spp);
-    if (entry.image) return Reference{std::move(*entry.image), source + " (cached)", path};
+    if (entry.reference)
+      return Reference{std::move(entry.reference->image), std::move(entry.reference->standardError),
+                       source + " (cached)", path};
     std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; computing it again\n",
                              path, entry.problem);
     recomputed = fmt::format(" (computed again: the cached entry was not trusted: {})", entry.problem);
@@ -171,9 +212,9 @@ Reference findReference(const Scene& scene, int spp, const std::string& cacheDir
                            kReferenceEstimator, spp, scene.grid.width, scene.grid.height,
                            fs::path(path).parent_path().string());
   // A seed of its own (top bit set), so a render with a small seed is independent of it.
-  RgbImage image = sampleReference(sampler(), scene, spp, 0x8000000000005eedull, reportProgress);
-  writeFileAtomically(path, encodeExr(image, cacheClaims(scene, spp, image)));
-  return Reference{image, source + recomputed, path};
+  SampledReference sampled = sampleReference(sampler(), scene, spp, 0x8000000000005eedull, reportProgress);
+  writeFileAtomically(path, encodeCacheEntry(scene, spp, sampled));
+  return Reference{std::move(sampled.image), std::move(sampled.standardError), source + recomputed, path};
 }
 
 }  // namespace misalloc

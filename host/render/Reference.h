@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "sampling/Sampler.h"
@@ -11,19 +12,32 @@ namespace misalloc {
 
 struct Reference {
   RgbImage image;
+  // Per pixel and channel, as image.rgb: the estimated standard deviation of the
+  // sampled image's own error, √Var(r) (a variance could overflow a float where a
+  // radiance does not); empty for an exact (analytic) reference and for a file given
+  // by the user, whose error is not known and taken as 0.
+  std::vector<float> standardError;
   std::string source;  // "analytic ([HS14] eq. 6.17)", or how it was sampled
   std::string path;    // the cached file, if any
+};
+
+// A sampled reference and the standard deviation of its error, as Reference's.
+struct SampledReference {
+  RgbImage image;
+  std::vector<float> standardError;
 };
 
 // [HS14] eq. 6.17: for R = cos^K θ and ω_o along the normal, L = R(2ρd/(K+2) +
 // ρs(n+2)/(n+K+2)), exact. Empty for any other scene.
 std::optional<RgbImage> analyticReference(const Scene& scene);
 
-// A converged image: equal-count MIS with `spp` samples per pixel, taken in stages of
-// at most 4096 so that no kernel launch runs for long. `progress`, if given, hears the
-// samples done after each stage.
-RgbImage sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
-                         const std::function<void(int done, int spp)>& progress = {});
+// A converged image: equal-count MIS with `spp` samples per pixel, in independent
+// batches of at most 4096 samples (no kernel launch runs for long) and at least M, at
+// most 16 of them where the budget allows: the spread of the batches' estimates gives
+// the variance of the image's own error. Throws InputError for a budget of fewer than
+// two batches of M samples. `progress`, if given, hears the samples done after each batch.
+SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
+                                 const std::function<void(int done, int spp)>& progress = {});
 
 // The cache key of a scene's reference: everything the pixel values depend on (the
 // envmap's texels, the analytic exponent, the grid, size and view) and the spp, not

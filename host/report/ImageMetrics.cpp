@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "Error.h"
@@ -22,6 +23,26 @@ double rmse(const RgbImage& image, const RgbImage& reference) {
     sum += d * d;
   }
   return std::sqrt(sum / double(image.rgb.size()));
+}
+
+CorrectedMse correctedMse(const RgbImage& image, const RgbImage& reference, const std::vector<float>& referenceError) {
+  checkSameSize(image, reference);
+  const size_t pixels = image.rgb.size() / 3;
+  double sum = 0, sumSquares = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    double term = 0;
+    for (size_t i = 3 * p; i < 3 * p + 3; ++i) {
+      const double d = double(image.rgb[i]) - reference.rgb[i];
+      const double e = referenceError.empty() ? 0.0 : referenceError[i];
+      term += d * d - e * e;
+    }
+    term /= 3;
+    sum += term;
+    sumSquares += term * term;
+  }
+  const double mean = sum / double(pixels);
+  const double spread = pixels > 1 ? std::max(0.0, (sumSquares - pixels * mean * mean) / double(pixels - 1)) : 0.0;
+  return {mean, std::sqrt(spread / double(pixels))};
 }
 
 double relativeMse(const RgbImage& image, const RgbImage& reference) {

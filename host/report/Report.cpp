@@ -1,5 +1,6 @@
 #include "report/Report.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "report/RunSummary.h"
@@ -100,7 +101,7 @@ nlohmann::json renderReport(const RenderRun& run) {
   double meanVariance = 0;
   for (double v : r.variance) meanVariance += v;
   meanVariance /= pixels;
-  const RunSummary summary = summarizeRun(r, M, run.reference ? &run.reference->image : nullptr);
+  const RunSummary summary = summarizeRun(r, M, run.reference ? &*run.reference : nullptr);
   nlohmann::json meanAlpha;
   auto names = run.scene.techniqueNames();
   for (int k = 0; k < M; ++k) meanAlpha[names[k]] = summary.meanAlpha[k];
@@ -159,6 +160,11 @@ nlohmann::json renderReport(const RenderRun& run) {
     report["reference"] = {{"source", run.reference->source}, {"path", run.reference->path}};
     report["rmse_x1000"] = 1000 * std::sqrt(*summary.mse);
     report["relative_mse"] = *summary.relativeMse;
+    // The error against the true image: the reference's own variance taken out.
+    report["rmse_x1000_corrected"] = 1000 * std::sqrt(std::max(0.0, summary.corrected->mse));
+    report["mse_corrected"] = summary.corrected->mse;
+    report["mse_corrected_standard_error"] = summary.corrected->standardError;
+    report["reference"]["variance_share"] = *summary.mse > 0 ? (*summary.mse - summary.corrected->mse) / *summary.mse : 0.0;
   } else {
     report["reference"] = nullptr;
   }

@@ -4,7 +4,7 @@
 
 namespace misalloc {
 
-RunSummary summarizeRun(const Rendering& r, int techniqueCount, const RgbImage* reference) {
+RunSummary summarizeRun(const Rendering& r, int techniqueCount, const Reference* reference) {
   const size_t M = size_t(techniqueCount), pixels = r.alpha.size() / M;
   RunSummary s;
   s.meanAlpha.assign(M, 0.0);
@@ -14,9 +14,10 @@ RunSummary summarizeRun(const Rendering& r, int techniqueCount, const RgbImage* 
   s.flooredFraction = double(r.flooredPixels) / double(pixels);
   s.skippedFraction = double(r.skippedPixels) / double(pixels);
   if (reference) {
-    const double e = rmse(r.image, *reference);
+    const double e = rmse(r.image, reference->image);
     s.mse = e * e;
-    s.relativeMse = relativeMse(r.image, *reference);
+    s.relativeMse = relativeMse(r.image, reference->image);
+    s.corrected = correctedMse(r.image, reference->image, reference->standardError);
   }
   return s;
 }

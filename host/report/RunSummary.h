@@ -4,7 +4,9 @@
 #include <optional>
 #include <vector>
 
+#include "render/Reference.h"
 #include "render/Render.h"
+#include "report/ImageMetrics.h"
 
 namespace misalloc {
 
@@ -13,9 +15,11 @@ struct RunSummary {
   double fallbackFraction = 0;    // pixels where an allocation rule fell back
   double flooredFraction = 0;     // pixels whose counts the floor raised to one per technique
   double skippedFraction = 0;     // pixels the skip rule kept at equal weights
-  std::optional<double> mse, relativeMse;  // against the reference, where there is one
+  // Against the reference, where there is one: raw, and corrected for its own variance.
+  std::optional<double> mse, relativeMse;
+  std::optional<CorrectedMse> corrected;
 };
 
-RunSummary summarizeRun(const Rendering& rendering, int techniqueCount, const RgbImage* reference);
+RunSummary summarizeRun(const Rendering& rendering, int techniqueCount, const Reference* reference);
 
 }  // namespace misalloc

@@ -219,12 +219,13 @@ std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes) {
 void writeExr(const std::string& path, const RgbImage& image) { writeFileAtomically(path, encodeExr(image)); }
 
 std::string encodeExrChannels(int width, int height, const std::vector<std::string>& names,
-                              const std::vector<std::vector<float>>& planes) {
+                              const std::vector<std::vector<float>>& planes, const ExrAttributes& attributes) {
   if (names.empty() || names.size() != planes.size())
     throw std::invalid_argument(fmt::format("{} channel names for {} planes", names.size(), planes.size()));
   if (std::set<std::string>(names.begin(), names.end()).size() != names.size())
     throw std::invalid_argument("EXR channel names must be distinct");
   Imf::Header header = floatHeader(width, height, names);
+  for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
   Imf::FrameBuffer frame;
   for (std::size_t k = 0; k < names.size(); ++k) {
     if (planes[k].size() != std::size_t(width) * std::size_t(height))
@@ -239,6 +240,31 @@ std::string encodeExrChannels(int width, int height, const std::vector<std::stri
 void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
                       const std::vector<std::vector<float>>& planes) {
   writeFileAtomically(path, encodeExrChannels(width, height, names, planes));
+}
+
+std::vector<std::vector<float>> readExrChannels(const std::string& path, const std::vector<std::string>& names) {
+  requireOpenExrFile(path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i& window = file.header().dataWindow();
+    const std::size_t width = std::size_t(widthOf(window)), values = width * std::size_t(heightOf(window));
+    std::vector<std::vector<float>> planes(names.size(), std::vector<float>(values));
+    Imf::FrameBuffer frame;
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      if (!file.header().channels().findChannel(names[k]))
+        throw InputError(fmt::format("'{}' has no channel {} (channels found: {})", path, names[k],
+                                     channelNames(file.header().channels())));
+      frame.insert(names[k], Imf::Slice::Make(Imf::FLOAT, planes[k].data(), window, sizeof(float),
+                                              sizeof(float) * width));
+    }
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    return planes;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(fmt::format("cannot read '{}' (truncated or corrupt?): {}", path, e.what()));
+  }
 }
 
 }  // namespace misalloc

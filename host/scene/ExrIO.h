@@ -51,9 +51,13 @@ std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes = {
 void writeExr(const std::string& path, const RgbImage& image);
 
 // One float channel per plane (width × height values, row 0 first), named by
-// `names`, e.g. per-pixel allocation maps.
+// `names`, e.g. per-pixel allocation maps, with `attributes` in the header.
 std::string encodeExrChannels(int width, int height, const std::vector<std::string>& names,
-                              const std::vector<std::vector<float>>& planes);
+                              const std::vector<std::vector<float>>& planes, const ExrAttributes& attributes = {});
+
+// The channels `names` of a file encodeExrChannels wrote, one plane each over its data
+// window. Throws InputError naming the file if it cannot be read or lacks a channel.
+std::vector<std::vector<float>> readExrChannels(const std::string& path, const std::vector<std::string>& names);
 
 // Writes encodeExrChannels's bytes through writeFileAtomically.
 void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,

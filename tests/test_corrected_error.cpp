@@ -1,0 +1,62 @@
+// The error against a sampled reference, corrected for the reference's own variance,
+// measures the error against the true image: checked where the true image is known,
+// [HS14] eq. 6.17 (cosk:K seen along the normal), against a deliberately noisy reference.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "Error.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "render/Reference.h"
+#include "report/ImageMetrics.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+TEST_CASE("the reference-corrected error agrees with the error against the exact image; the raw one does not",
+          "[reference][corrected]") {
+  for (double K : {1.0, 3.0}) {
+    const Scene scene = smallScene(fmt::format("cosk:{}", K), "seed000", 64, 64);
+    const RgbImage exact = *analyticReference(scene);
+    Sampler sampler(testDevice(), scene, {Estimator::MultiSample, 0, 0});
+    // A reference with as many samples as the render: its own variance is about the
+    // render's error, so the raw error is about twice the true one.
+    SampledReference noisy = sampleReference(sampler, scene, 64, 0x8000000000000001ull);
+    RgbImage render{scene.grid.width, scene.grid.height, {}};
+    StageResult stage = sampler.run(singleStagePlan(scene, Method::Equal, 64), 5);
+    render.rgb.assign(stage.rgb.begin(), stage.rgb.end());
+
+    const double trueMse = std::pow(rmse(render, exact), 2);
+    const CorrectedMse corrected = correctedMse(render, noisy.image, noisy.standardError);
+    const double raw = std::pow(rmse(render, noisy.image), 2);
+    const double zCorrected = (corrected.mse - trueMse) / corrected.standardError;
+    const double zRaw = (raw - trueMse) / corrected.standardError;
+    INFO(fmt::format("K {}: true MSE {:.4g}, corrected {:.4g} ± {:.2g} (z {:.2f}), raw {:.4g} (z {:.1f})", K, trueMse,
+                     corrected.mse, corrected.standardError, zCorrected, raw, zRaw));
+    CHECK(std::abs(zCorrected) < kMaxZ);
+    CHECK(zRaw > 2 * kMaxZ);
+    // Against the exact reference (no variance) the corrected error is the raw one.
+    CHECK(correctedMse(render, exact, {}).mse == Approx(trueMse).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("a sampled reference estimates its own variance from independent batches", "[reference][corrected]") {
+  // The batches' spread estimates Var(r) without bias: over the pixels of a uniform
+  // grid, the mean estimated variance matches the spread of the pixels' values.
+  const Scene scene = smallScene("cosk:1", "uniform:0.5,0.5,5", 32, 32);
+  Sampler sampler(testDevice(), scene, {Estimator::MultiSample, 0, 0});
+  SampledReference r = sampleReference(sampler, scene, 64, 0x8000000000000002ull);
+  const double expected = closedForm(0.5, 0.5, 5, 1);
+  double estimated = 0, measured = 0;
+  const size_t values = r.image.rgb.size();
+  for (size_t i = 0; i < values; i += 3) {
+    estimated += std::pow(r.standardError[i], 2) / double(values / 3);
+    measured += std::pow(r.image.rgb[i] - expected, 2) / double(values / 3);
+  }
+  INFO(fmt::format("mean estimated Var(r) {:.4g}, measured {:.4g}", estimated, measured));
+  // 1024 pixels: each mean has a relative standard error of a few percent.
+  CHECK(estimated == Approx(measured).epsilon(0.2));
+  CHECK_THROWS_AS(sampleReference(sampler, scene, 3, 1), InputError);
+}
