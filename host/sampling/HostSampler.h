@@ -1,5 +1,4 @@
 #pragma once
-#include <memory>
 #include <vector>
 
 #include "sampling/StageSampler.h"
@@ -15,21 +14,18 @@ class HostSampler : public StageSampler {
   std::vector<double> statistics() override { return stats_; }
   std::vector<float> storedSamples() override { return samples_; }
   std::vector<DeviceShare> deviceShares() const override { return {share_}; }
+  const Device* storedSampleDevice() const override { return nullptr; }
 
  private:
   StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
   void loadStatistics(const std::vector<double>& stats) override { stats_ = stats; }
   void loadStoredSamples(const std::vector<float>& samples) override { samples_ = samples; }
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                          const std::optional<PooledSelection>& pooling) override {
-    return gridSearch_->run(samples_, layout, costs, rule, pooling);
-  }
+  StoredSampleBuffer storedSampleBuffer() override { return {nullptr, nullptr, &samples_}; }
   void forgetStages() override;
 
   std::vector<double> stats_;
   std::vector<float> samples_;
-  std::unique_ptr<GridSearchReference> gridSearch_;  // where config().gridSize > 0
-  DeviceShare share_;                                // since reset()
+  DeviceShare share_;  // since reset()
 };
 
 }  // namespace misalloc

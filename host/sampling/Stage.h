@@ -1,7 +1,10 @@
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "Constants.h"
 
 namespace misalloc {
 
@@ -70,6 +73,21 @@ struct SamplerConfig {
   int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
   // The grid searches keep running sums, for renders that search more than once.
   bool runningSums = true;
+};
+
+// Where the stored samples are: the blocked float layout of kernels/stats.h
+// (storedSampleIndex), `capacity` slots per pixel of which the first `taken` are filled
+// for every pixel, pixels padded to a multiple of 16. A search reads the `taken`
+// samples as those taken since the previous search.
+struct StoredSampleLayout {
+  int pixelCount = 0;
+  int techniqueCount = 0;
+  int capacity = 0;
+  int taken = 0;
+
+  std::size_t floatCount() const {
+    return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
+  }
 };
 
 }  // namespace misalloc

@@ -24,11 +24,6 @@ size_t StageSampler::storedSampleCount() const {
   return paddedPixels * size_t(config_.sampleCapacity) * size_t(scene_.techniqueCount() + 2);
 }
 
-size_t StageSampler::searchBytesPerPixel() const {
-  return config_.gridSize > 0 ? gridSearchBytesPerPixel(scene_.techniqueCount(), config_.gridSize, config_.runningSums)
-                              : 0;
-}
-
 int StageSampler::takeSlots(const StagePlan& plan) {
   if (closed_) throw std::logic_error("a stage after the stage without statistics");
   if (!plan.keepStatistics) {
@@ -43,15 +38,13 @@ int StageSampler::takeSlots(const StagePlan& plan) {
   return slot;
 }
 
-GridSearchResult StageSampler::searchWeights(const std::vector<double>& costs, GridRule rule,
-                                             const std::optional<PooledSelection>& pooling) {
-  if (config_.gridSize <= 0 || config_.sampleCapacity <= 0)
-    throw std::logic_error("grid search on a sampler that does not keep what it needs");
-  GridSearchResult result = search(
+StoredSamples StageSampler::takeStoredSamples() {
+  if (config_.sampleCapacity <= 0) throw std::logic_error("a search on a sampler that stores no samples");
+  StoredSamples stored{
       StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken_ - searched_},
-      costs, rule, pooling);
+      storedSampleBuffer()};
   searched_ = taken_;
-  return result;
+  return stored;
 }
 
 StageResult StageSampler::run(const StagePlan& plan, uint64_t seed) {

@@ -1,13 +1,28 @@
 #pragma once
+#include <CL/opencl.hpp>
 #include <cstdint>
-#include <optional>
+#include <memory>
 #include <vector>
 
-#include "sampling/GridSearch.h"
+#include "cl/Device.h"
 #include "sampling/Stage.h"
 #include "scene/Scene.h"
 
 namespace misalloc {
+
+// Where a sampler keeps its stored samples: in `buffer` on `device`, or in `host`
+// memory.
+struct StoredSampleBuffer {
+  const Device* device = nullptr;
+  const cl::Buffer* buffer = nullptr;
+  const std::vector<float>* host = nullptr;
+};
+
+// The samples stored since the previous search, and where they are.
+struct StoredSamples {
+  StoredSampleLayout layout;
+  StoredSampleBuffer where;
+};
 
 // Takes sampling stages for every pixel and keeps the running sums and stored samples
 // that its config asks for, across stages.
@@ -22,21 +37,31 @@ class StageSampler {
   // samples in the layout of kernels/stats.h's storedSampleIndex.
   virtual std::vector<double> statistics() = 0;
   virtual std::vector<float> storedSamples() = 0;
-  // [HS14] Algorithm 1 over every sample taken so far, with the grid of config().gridSize:
-  // the searches keep running sums, and each adds the samples of the stages since the
-  // one before (kernels/gridsearch.cl on a device, its C++ reference on the host).
-  // `pooling`: select by rule (b) over neighbourhoods, with the skip rule.
-  GridSearchResult searchWeights(const std::vector<double>& costs, GridRule rule,
-                                 const std::optional<PooledSelection>& pooling = std::nullopt);
-  // Forgets every stage taken so far (running sums, the grid searches' sums), so that
+  // The samples stored since the previous call, for a search that reads them where
+  // they are and adds them to sums of its own (alloc/GridSearchAllocator.h): the next
+  // stage stores from slot 0 again. Throws std::logic_error where the config stores none.
+  StoredSamples takeStoredSamples();
+  // The device that holds the stored samples, on which a search reads them; null for
+  // host memory.
+  virtual const Device* storedSampleDevice() const = 0;
+  // Forgets every stage taken so far (running sums, stored samples), so that
   // the next stage starts a new render on the same compiled kernels.
   void reset();
 
   const Scene& scene() const { return scene_; }
   const SamplerConfig& config() const { return config_; }
-  int statSlots() const;               // running sums per pixel
-  size_t storedSampleCount() const;    // floats in the stored-samples buffer
-  size_t searchBytesPerPixel() const;  // the grid searches' running sums
+  int statSlots() const;                       // running sums per pixel
+  size_t storedSampleCount() const;            // floats in the stored-samples buffer
+  int samplesTaken() const { return taken_; }  // per pixel, by the stages that keep statistics
+
+  // What an allocation builds once for this sampler's stored samples and keeps from
+  // render to render: the grid search's kernels and sums (alloc/GridSearchAllocator.h).
+  // The sampler holds it because it reads the sampler's buffers and so must not outlive
+  // them.
+  struct Kept {
+    virtual ~Kept() = default;
+  };
+  std::unique_ptr<Kept>& kept() { return kept_; }
 
   // Where the stages since reset() ran, for the report: every device's share (one
   // entry for a single device), and how far apart their last tiles finished.
@@ -55,20 +80,21 @@ class StageSampler {
   virtual void loadStoredSamples(const std::vector<float>& samples) = 0;
 
   // Records the stage and returns the stored-samples slot of its first sample. Slot i
-  // holds sample searched_ + i: the samples before are in the grid searches' sums.
+  // holds sample searched_ + i: the samples before are in a search's sums.
   // Throws std::logic_error if the stage does not fit.
   int takeSlots(const StagePlan& plan);
-  virtual GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                                  const std::optional<PooledSelection>& pooling) = 0;
+  // Where the stored samples are, brought up to date for a search.
+  virtual StoredSampleBuffer storedSampleBuffer() = 0;
   virtual void forgetStages() = 0;
 
   const Scene& scene_;
   SamplerConfig config_;
 
  private:
-  int searched_ = 0;     // samples per pixel that the grid searches have added
+  int searched_ = 0;     // samples per pixel that a search has taken (takeStoredSamples)
   int taken_ = 0;        // samples per pixel taken so far
   bool closed_ = false;  // a stage without statistics was taken: it must be the last
+  std::unique_ptr<Kept> kept_;
 };
 
 // Whether a sampler with this config keeps anything beyond the stage estimates, and

@@ -164,14 +164,13 @@ void TiledSampler::loadStoredSamples(const std::vector<float>& samples) {
   std::fill(loaded_.begin(), loaded_.end(), 0);
 }
 
-GridSearchResult TiledSampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                                      const std::optional<PooledSelection>& pooling) {
-  // The grid search's sums of earlier searches live on the member that ran them.
+StoredSampleBuffer TiledSampler::storedSampleBuffer() {
+  // The grid search's sums of earlier searches live on the first member's device.
   if (!live(0))
     throw DeviceError(
         fmt::format("{} runs the grid search and failed: {}", members_[0]->deviceShares().front().name, failures_[0]));
   loadMembers(1);
-  return members_[0]->search(layout, costs, rule, pooling);
+  return members_[0]->storedSampleBuffer();
 }
 
 void TiledSampler::forgetStages() {

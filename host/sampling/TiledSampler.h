@@ -29,6 +29,9 @@ class TiledSampler : public StageSampler {
   std::vector<float> storedSamples() override { return samples_; }
   std::vector<DeviceShare> deviceShares() const override;
   double imbalanceSeconds() const override { return imbalanceSeconds_; }
+  // The first member's: a search reads the samples there, where its sums of earlier
+  // searches are.
+  const Device* storedSampleDevice() const override { return members_[0]->storedSampleDevice(); }
 
  private:
   // A stage's result: the wall time from the first launch to the last finish is its
@@ -36,8 +39,7 @@ class TiledSampler : public StageSampler {
   StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
   void loadStatistics(const std::vector<double>& stats) override;
   void loadStoredSamples(const std::vector<float>& samples) override;
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                          const std::optional<PooledSelection>& pooling) override;
+  StoredSampleBuffer storedSampleBuffer() override;
   void forgetStages() override;
 
   bool live(size_t member) const { return failures_[member].empty(); }
