@@ -8,9 +8,9 @@
 namespace misalloc {
 namespace {
 
-// The search a sampler keeps (StageSampler::kept): on the device that holds its stored
+// The search a sampler keeps (StageStatistics::kept): on the device that holds its stored
 // samples, else the C++ reference on the host.
-struct KeptGridSearch final : StageSampler::Kept {
+struct KeptGridSearch final : StageStatistics::Kept {
   std::unique_ptr<GridSearch> device;
   std::unique_ptr<GridSearchReference> host;
 
@@ -22,12 +22,12 @@ struct KeptGridSearch final : StageSampler::Kept {
   void reset() { device ? device->reset() : host->reset(); }
 };
 
-KeptGridSearch& keptSearch(StageSampler& sampler) {
-  if (auto* kept = dynamic_cast<KeptGridSearch*>(sampler.kept().get())) return *kept;
-  const Scene& scene = sampler.scene();
-  const SamplerConfig& config = sampler.config();
+KeptGridSearch& keptSearch(StageStatistics& stages) {
+  if (auto* kept = dynamic_cast<KeptGridSearch*>(stages.kept().get())) return *kept;
+  const Scene& scene = stages.scene();
+  const SamplerConfig& config = stages.config();
   auto kept = std::make_unique<KeptGridSearch>();
-  if (const Device* device = sampler.storedSampleDevice()) {
+  if (const Device* device = stages.storedSampleDevice()) {
     try {
       kept->device = std::make_unique<GridSearch>(*device, scene.techniqueCount(), scene.pixelCount(), config.gridSize,
                                                   config.runningSums);
@@ -39,24 +39,24 @@ KeptGridSearch& keptSearch(StageSampler& sampler) {
     kept->host = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize,
                                                        config.runningSums);
   }
-  sampler.kept() = std::move(kept);
-  return static_cast<KeptGridSearch&>(*sampler.kept());
+  stages.kept() = std::move(kept);
+  return static_cast<KeptGridSearch&>(*stages.kept());
 }
 
 }  // namespace
 
-GridSearchAllocator::GridSearchAllocator(StageSampler& sampler, std::vector<double> costs, GridRule rule,
+GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, std::vector<double> costs, GridRule rule,
                                          std::optional<PooledSelection> pooling)
     : costs_(std::move(costs)), rule_(rule), pooling_(pooling) {
-  const SamplerConfig& config = sampler.config();
+  const SamplerConfig& config = stages.config();
   if (config.gridSize <= 0 || config.sampleCapacity <= 0)
     throw std::logic_error("grid search on a sampler that does not keep what it needs");
-  keptSearch(sampler).reset();
-  bytesPerPixel_ = gridSearchBytesPerPixel(sampler.scene().techniqueCount(), config.gridSize, config.runningSums);
+  keptSearch(stages).reset();
+  bytesPerPixel_ = gridSearchBytesPerPixel(stages.scene().techniqueCount(), config.gridSize, config.runningSums);
 }
 
-StageAllocation GridSearchAllocator::allocate(StageSampler& sampler) {
-  GridSearchResult search = keptSearch(sampler).run(sampler.takeStoredSamples(), costs_, rule_, pooling_);
+StageAllocation GridSearchAllocator::allocate(StageStatistics& stages) {
+  GridSearchResult search = keptSearch(stages).run(stages.takeStoredSamples(), costs_, rule_, pooling_);
   return {std::move(search.allocations), std::move(search.varianceRatio), std::move(search.skipped)};
 }
 

@@ -13,18 +13,19 @@ namespace misalloc {
 
 class GridSearchAllocator final : public StageAllocator {
  public:
-  // Starts a new search over the samples of `sampler`, whose config gives the grid
-  // (gridSize) and whether the sums are kept (runningSums). The search's kernels and
-  // buffers are built at the sampler's first search and kept with it
-  // (StageSampler::kept), so that later renders do not pay for them. `pooling`: rule (b)
-  // over neighbourhoods, with the skip rule. Throws std::logic_error for a sampler
-  // that keeps no grid, DeviceError where the grid's buffers do not fit the device.
-  GridSearchAllocator(StageSampler& sampler, std::vector<double> costs, GridRule rule,
+  // Starts a new search over the samples a sampler stores (`stages`), whose config
+  // gives the grid (gridSize) and whether the sums are kept (runningSums). The search's
+  // kernels and buffers are built at the sampler's first search and kept with it
+  // (StageStatistics::kept), so that later renders do not pay for them. `pooling`:
+  // rule (b) over neighbourhoods, with the skip rule. Throws std::logic_error for a
+  // sampler that keeps no grid, DeviceError where the grid's buffers do not fit the
+  // device.
+  GridSearchAllocator(StageStatistics& stages, std::vector<double> costs, GridRule rule,
                       std::optional<PooledSelection> pooling);
 
   // Adds the samples stored since the last search to the search's sums and selects
   // by all of them.
-  StageAllocation allocate(StageSampler& sampler) override;
+  StageAllocation allocate(StageStatistics& stages) override;
   std::size_t bytesPerPixel() const override { return bytesPerPixel_; }
 
  private:

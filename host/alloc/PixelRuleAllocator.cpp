@@ -28,14 +28,14 @@ PixelRuleAllocator::PixelRuleAllocator(PixelRule rule, std::vector<double> costs
                                        ZeroWeightRule linearRule)
     : rule_(rule), costs_(std::move(costs)), poolRadius_(poolRadius), linearRule_(linearRule) {}
 
-StageAllocation PixelRuleAllocator::allocate(StageSampler& sampler) {
-  const Scene& scene = sampler.scene();
-  const SamplerConfig& config = sampler.config();
-  const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = sampler.statSlots();
-  std::vector<double> stats = sampler.statistics();
+StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages) {
+  const Scene& scene = stages.scene();
+  const SamplerConfig& config = stages.config();
+  const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = stages.statSlots();
+  std::vector<double> stats = stages.statistics();
   poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius_);
-  const std::vector<float> stored = rule_ == PixelRule::Linear ? sampler.storedSamples() : std::vector<float>{};
-  const int taken = sampler.samplesTaken();
+  const std::vector<float> stored = rule_ == PixelRule::Linear ? stages.storedSamples() : std::vector<float>{};
+  const int taken = stages.samplesTaken();
   StageAllocation out{std::vector<Allocation>(pixels), std::vector<float>(pixels, 1.0f),
                       std::vector<unsigned char>(pixels, 0)};
 #pragma omp parallel for schedule(dynamic, 256)

@@ -27,7 +27,7 @@ class PixelRuleAllocator final : public StageAllocator {
 
   // Every pixel's α from its pooled running sums (and for the linear rule its samples);
   // varianceRatio 1 and skipped 0 everywhere: the rules predict no gain.
-  StageAllocation allocate(StageSampler& sampler) override;
+  StageAllocation allocate(StageStatistics& stages) override;
 
  private:
   PixelRule rule_;

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "alloc/Allocation.h"
-#include "sampling/StageSampler.h"
+#include "sampling/StageStatistics.h"
 
 namespace misalloc {
 
@@ -25,9 +25,9 @@ class StageAllocator {
  public:
   virtual ~StageAllocator() = default;
 
-  // Every pixel's α for the next stage, from all the samples `sampler` took since its
-  // reset().
-  virtual StageAllocation allocate(StageSampler& sampler) = 0;
+  // Every pixel's α for the next stage, from what the stages of a sampler since its
+  // reset() left in `stages`: its running sums, its stored samples.
+  virtual StageAllocation allocate(StageStatistics& stages) = 0;
   // What the allocation keeps per pixel beside the sampler's running sums and stored
   // samples, for the report.
   virtual std::size_t bytesPerPixel() const { return 0; }

@@ -38,18 +38,20 @@ class Sampler : public StageSampler {
   // its own.
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
           std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
-  std::vector<DeviceShare> deviceShares() const override;
+  void loadStatistics(const std::vector<double>& stats) override;
+  void loadStoredSamples(const std::vector<float>& samples) override;
   // A sub-device's whole device, which shares its context and so reads the stored
   // samples where they are: a search is not split into tiles.
   const Device* storedSampleDevice() const override { return device_.whole ? device_.whole.get() : &device_; }
-
- protected:  // tests/test_devices.cpp injects failures into runPixels
-  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
-  void loadStatistics(const std::vector<double>& stats) override;
-  void loadStoredSamples(const std::vector<float>& samples) override;
   StoredSampleBuffer storedSampleBuffer() override { return {storedSampleDevice(), &samples_, nullptr}; }
+
+  std::vector<DeviceShare> deviceShares() const override;
+
+ protected:
   void forgetStages() override;
 
  private:

@@ -1,7 +1,6 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
-#include <string>
 #include <vector>
 
 #include "Constants.h"
@@ -42,25 +41,6 @@ struct StageResult {
   std::vector<double> rgb;      // [pixel·3 + c]
   std::vector<double> moments;  // [(pixel·M + k)·2 + {0, 1}]
   double kernelSeconds = 0;
-};
-
-// One device's part in the stages since a sampler's reset(), for the report.
-struct DeviceShare {
-  std::string name;
-  std::string launch;         // its local size and why (cl/LaunchShape.h); empty on the host
-  long long pixelStages = 0;  // pixels it ran, summed over the stages
-  long long samples = 0;      // samples it took
-  int tiles = 0;              // kernel launches
-  double kernelSeconds = 0;   // its own device time
-  std::string failure;        // why it stopped, if it failed: its tiles ran elsewhere
-
-  // The same device with nothing run yet (StageSampler::reset).
-  DeviceShare restarted() const {
-    DeviceShare fresh;
-    fresh.name = name;
-    fresh.launch = launch;
-    return fresh;
-  }
 };
 
 // What a sampler keeps beyond the stage estimates, for the allocations.

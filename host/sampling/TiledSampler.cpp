@@ -175,7 +175,7 @@ StoredSampleBuffer TiledSampler::storedSampleBuffer() {
 
 void TiledSampler::forgetStages() {
   for (size_t d = 0; d < members_.size(); ++d)
-    if (live(d)) members_[d]->forgetStages();
+    if (live(d)) members_[d]->reset();
   loaded_.assign(members_.size(), 1);  // every member starts from zero sums, as stats_
   stats_.assign(size_t(scene_.pixelCount()) * statSlots(), 0.0);
   samples_ = config_.sampleCapacity > 0 ? emptyStoredSamples(scene_, config_.sampleCapacity) : std::vector<float>{};
