@@ -179,19 +179,21 @@ std::unique_ptr<StageAllocator> makeStageAllocator(StageSampler& sampler, Method
     if (pooled) pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
     return std::make_unique<GridSearchAllocator>(sampler, options.costs, rule, pooling);
   }
+  PixelRule rule;
   switch (method) {
     case Method::Heuristic:
-      return std::make_unique<PixelRuleAllocator>(PixelRule::Heuristic, options.costs, options.poolRadius,
-                                                  options.linearRule);
+      rule = PixelRule::Heuristic;
+      break;
     case Method::SigmaSqrtC:
-      return std::make_unique<PixelRuleAllocator>(PixelRule::SigmaSqrtC, options.costs, options.poolRadius,
-                                                  options.linearRule);
+      rule = PixelRule::SigmaSqrtC;
+      break;
     case Method::Linear:
-      return std::make_unique<PixelRuleAllocator>(PixelRule::Linear, options.costs, options.poolRadius,
-                                                  options.linearRule);
+      rule = PixelRule::Linear;
+      break;
     default:
       throw std::logic_error("no allocation for " + methodName(method));
   }
+  return std::make_unique<PixelRuleAllocator>(rule, options.costs, options.poolRadius, options.linearRule);
 }
 
 }  // namespace
