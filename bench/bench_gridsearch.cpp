@@ -22,8 +22,8 @@
 #include "Constants.h"
 #include "KernelCode.h"
 #include "PeerComparison.h"
+#include "alloc/GridSearch.h"
 #include "cl/Device.h"
-#include "sampling/GridSearch.h"
 
 using namespace misalloc;
 

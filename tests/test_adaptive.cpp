@@ -155,7 +155,7 @@ TEST_CASE("the skip rule keeps equal counts where adapting cannot pay, and only 
 TEST_CASE("the pilot weighs less where the neighbours predict that alpha beats equal counts", "[adaptive]") {
   // A constant sky over a diffuse surface: BRDF sampling alone has no variance, so the
   // pilot's equal counts are far worse than the α after it and weigh less than their share
-  // (host/render/Render.cpp, pilotWeight). With --pool 0 a pixel has no neighbours to
+  // (host/alloc/StageWeights.cpp, pilotWeight). With --pool 0 a pixel has no neighbours to
   // predict the ratio from, and the pilot keeps its share N_0/N = 5/100.
   Scene constant = smallScene("constant", "uniform:1,0,1", 24, 16);
   AdaptiveOptions options;

@@ -17,10 +17,10 @@
 #include "Error.h"
 #include "KernelCode.h"
 #include "Statistics.h"
+#include "distributions/AliasTable.h"
+#include "distributions/EnvmapDistribution.h"
 #include "sampling/KernelViews.h"
-#include "scene/AliasTable.h"
 #include "scene/Envmap.h"
-#include "scene/EnvmapDistribution.h"
 
 namespace kern = misalloc::kern;
 using Catch::Matchers::Contains;
@@ -360,7 +360,7 @@ TEST_CASE("the kernels' samplers draw texels with the stored probabilities, neve
 
 TEST_CASE("the optimal pdf's bank draws texels with the probabilities it evaluates, which integrate to 1",
           "[envmap][optimal]") {
-  // [Kar19] eq. 9 per BRDF bin and envmap share (host/scene/OptimalBank.h): a block by
+  // [Kar19] eq. 9 per BRDF bin and envmap share (host/distributions/OptimalBank.h): a block by
   // the entry's table, then a texel of the block by the plain weights. The first and the
   // last entry of each map and sampler; a false alarm in any χ² test with probability 2 %.
   const misalloc::BrdfGrid grid = misalloc::makeBrdfGrid("seed000", 8, 8);

@@ -15,10 +15,10 @@
 
 #include "KernelCode.h"
 #include "TestDevice.h"
+#include "alloc/GridSearch.h"
 #include "paper/MixtureVariance.h"
 #include "paper/PaperExamples.h"
 #include "paper/Quadrature.h"
-#include "sampling/GridSearch.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -437,7 +437,7 @@ TEST_CASE("a search without running sums selects as one with them, and refuses a
 }
 
 TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not its own", "[exact]") {
-  // The pilot's weight (host/render/Render.cpp, pilotWeight) must not depend on the
+  // The pilot's weight (host/alloc/StageWeights.cpp, pilotWeight) must not depend on the
   // pilot it weighs: the selection, the skip and the variance ratio of a pixel stay
   // the same, bit for bit, when its own samples change, while its neighbours see the
   // change. The kernel selects as its reference.

@@ -1,4 +1,4 @@
-// The optimal envmap pdf of [Kar19] eq. 9 and its bank (host/scene/OptimalBank.h):
+// The optimal envmap pdf of [Kar19] eq. 9 and its bank (host/distributions/OptimalBank.h):
 // λ's bisection within eq. 10 on stiff cases, the binning of the grid's BRDFs, the
 // entry a stage samples with, and what the bank's tables hold. Its sampler and
 // unbiasedness are tested with the other pdfs' (test_envmap.cpp, test_compensated.cpp,
@@ -9,8 +9,8 @@
 
 #include "KernelCode.h"
 #include "SceneFixtures.h"
-#include "scene/CompensatedPdf.h"
-#include "scene/OptimalBank.h"
+#include "distributions/CompensatedPdf.h"
+#include "distributions/OptimalBank.h"
 
 using namespace misalloc;
 using namespace misalloc::test;

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "alloc/Apportion.h"
+#include "alloc/StageWeights.h"
 #include "paper/InverseCdfSampler.h"
 #include "paper/MixtureOptimizer.h"
 #include "paper/MixtureVariance.h"

@@ -52,4 +52,17 @@ std::vector<int> apportionCounts(const std::vector<double>& alpha, int total) {
   return counts;
 }
 
+bool floorCounts(int* counts, int m) {
+  bool changed = false;
+  for (int k = 0; k < m; ++k) {
+    if (counts[k] > 0) continue;
+    int* largest = std::max_element(counts, counts + m);
+    if (*largest <= 1) break;
+    --*largest;
+    counts[k] = 1;
+    changed = true;
+  }
+  return changed;
+}
+
 }  // namespace misalloc

@@ -14,4 +14,14 @@ std::vector<int> apportionCounts(const std::vector<double>& alpha, int total);
 // apportions every pixel's stage.
 void apportionCounts(const double* alpha, int m, int total, int* counts);
 
+// Every technique takes at least one sample of each stage. The count-independent
+// estimator ([SHS16] eq. 26) needs one of each technique for all its terms, and with the
+// BRDF split into lobes the specular lobe alone does not cover the diffuse lobe's
+// support. With the balance heuristic and M = 2 either technique alone is unbiased, but
+// a pilot that misses a sun (rooitou_park: 0.1 % of the texels) can drive α_envmap to
+// 0; the estimate then rests on rare BRDF hits of the sun, unbiased yet so heavy-tailed
+// that it comes out low almost always (tests/test_stability.cpp). True if it changed
+// the counts: the report counts those pixels.
+bool floorCounts(int* counts, int m);
+
 }  // namespace misalloc

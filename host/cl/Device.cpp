@@ -8,6 +8,8 @@
 #include "cl/KernelSource.h"
 
 namespace misalloc {
+std::string mebibytes(uint64_t bytes) { return fmt::format("{:.0f} MiB", double(bytes) / (1 << 20)); }
+
 namespace {
 
 const char* kInstallAdvice =
@@ -156,6 +158,21 @@ double eventSeconds(const cl::Event& event) {
   return double(event.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                 event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
          1e-9;
+}
+
+DeviceError explainBufferError(const cl::Error& e, const Device& device, const std::string& cause, int pixels) {
+  const std::string code = fmt::format("OpenCL error {} in {}", e.err(), e.what());
+  switch (e.err()) {
+    case CL_INVALID_BUFFER_SIZE:
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+    case CL_OUT_OF_RESOURCES:
+      return DeviceError(
+          fmt::format("{} for {} pixels: a buffer is larger than {} can hold: at most {} in one buffer, {} in all ({})",
+                      cause, pixels, device.name(), mebibytes(device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>()),
+                      mebibytes(device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>()), code));
+    default:
+      return DeviceError(code);
+  }
 }
 
 }  // namespace misalloc

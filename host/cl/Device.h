@@ -1,9 +1,12 @@
 #pragma once
 #include <CL/opencl.hpp>
+#include <cstdint>
 #include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
+
+#include "Error.h"
 
 namespace misalloc {
 
@@ -40,6 +43,14 @@ std::vector<Device> openSubDevices(const std::string& spec, int count);
 
 // The device time between a command's start and end (profiling events).
 double eventSeconds(const cl::Event& event);
+
+// A byte count in MiB, for the errors that give a device's limits.
+std::string mebibytes(uint64_t bytes);
+
+// An OpenCL error in words, with the option that caused it where it says so: for a
+// buffer that `device` cannot hold, `cause` (the option that sized the buffers, for
+// `pixels` pixels) and the device's limits; any other error by its code.
+DeviceError explainBufferError(const cl::Error& e, const Device& device, const std::string& cause, int pixels);
 
 // Builds `mainFile` (an embedded kernel source) with `options`; a failure throws
 // DeviceError carrying the build log.

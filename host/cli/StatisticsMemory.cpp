@@ -35,7 +35,7 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
   if (config.gridSize > 0) {
     // The weight grid, M weights and a cost per combination, is built on the host; the
     // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
-    // where a render searches more than once (sampling/GridSearch.h). Both from the
+    // where a render searches more than once (alloc/GridSearch.h). Both from the
     // options alone: building the grid to size it would be the allocation this check
     // prevents.
     const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);

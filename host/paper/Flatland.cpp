@@ -3,8 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "distributions/CompensatedPdf.h"
 #include "paper/Quadrature.h"
-#include "scene/CompensatedPdf.h"
 
 namespace misalloc {
 namespace {

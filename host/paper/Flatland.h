@@ -11,7 +11,7 @@
 // 0.5; each bin holds the average over it.
 #include <vector>
 
-#include "scene/CompensatedPdf.h"
+#include "distributions/CompensatedPdf.h"
 
 namespace misalloc {
 

@@ -27,7 +27,7 @@ struct MethodTraits {
   Method method;
   const char* name;
   Split split;
-  // α from the grid search over U weight combinations (sampling/GridSearch.h, [HS14]
+  // α from the grid search over U weight combinations (alloc/GridSearch.h, [HS14]
   // Algorithm 1); an adaptive method without it has a per-pixel rule from its running
   // sums or samples (alloc/).
   bool searchesWeights;

@@ -5,15 +5,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numeric>
+#include <optional>
+#include <stdexcept>
 
 #include "Error.h"
 #include "alloc/Apportion.h"
-#include "alloc/HeuristicAllocation.h"
-#include "alloc/SigmaAllocation.h"
+#include "alloc/GridSearchAllocator.h"
+#include "alloc/PixelRuleAllocator.h"
+#include "alloc/StageWeights.h"
 #include "render/RunChecks.h"
-#include "stats/Pooling.h"
-#include "stats/RunningStats.h"
 
 namespace misalloc {
 namespace {
@@ -21,42 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-// One pixel's weights for the next stage, from its samples so far.
-Allocation allocatePixel(Method method, const AdaptiveOptions& options, const PixelStats& stats,
-                         const PixelSamples* samples) {
-  switch (method) {
-    case Method::Heuristic:
-      return allocateHeuristic(stats, options.costs);  // [HS14] eq. 4.20
-    case Method::SigmaSqrtC:
-      return allocateSigmaSqrtC(stats, options.costs);  // [SHS16] eq. 31
-    case Method::Linear:
-      return allocateLinear(*samples, options.linearRule);  // [SS23] eq. 14
-    default:
-      throw std::logic_error("no per-pixel rule for " + methodName(method));
-  }
-}
-
-// Every technique takes at least one sample of each stage. The count-independent
-// estimator ([SHS16] eq. 26) needs one of each technique for all its terms, and with the
-// BRDF split into lobes the specular lobe alone does not cover the diffuse lobe's
-// support. With the balance heuristic and M = 2 either technique alone is unbiased, but
-// a pilot that misses a sun (rooitou_park: 0.1 % of the texels) can drive α_envmap to
-// 0; the estimate then rests on rare BRDF hits of the sun, unbiased yet so heavy-tailed
-// that it comes out low almost always (tests/test_stability.cpp). True if it changed
-// the counts: the report counts those pixels.
-bool floorCounts(int* counts, int m) {
-  bool changed = false;
-  for (int k = 0; k < m; ++k) {
-    if (counts[k] > 0) continue;
-    int* largest = std::max_element(counts, counts + m);
-    if (*largest <= 1) break;
-    --*largest;
-    counts[k] = 1;
-    changed = true;
-  }
-  return changed;
-}
 
 struct StageTotals {
   std::vector<double> rgb, variance;
@@ -97,31 +63,6 @@ std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techn
   return sizes;
 }
 
-double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator) {
-  const int M = plan.techniqueCount;
-  const double N = plan.stageSamples;
-  const double* m = result.moments.data() + size_t(pixel) * M * 2;
-  const int* counts = plan.counts.data() + size_t(pixel) * M;
-  if (estimator == Estimator::OneSample) {
-    double sum = 0, sumSquares = 0;
-    for (int k = 0; k < M; ++k) sum += m[2 * k], sumSquares += m[2 * k + 1];
-    return sampleVariance(sum, sumSquares, N) / N;
-  }
-  double v = 0;
-  for (int k = 0; k < M; ++k) {
-    double n = counts[k];
-    if (n == 0) continue;
-    double s2 = sampleVariance(m[2 * k], m[2 * k + 1], n);
-    v += estimator == Estimator::CountIndependent ? s2 / n : n * s2 / (N * N);
-  }
-  return v;
-}
-
-double pilotWeight(float varianceRatio, int pilotSamples, int spp) {
-  const double r = std::isnan(varianceRatio) ? 1.0 : double(varianceRatio);
-  return pilotSamples / (pilotSamples + (spp - pilotSamples) * r);
-}
-
 namespace {
 
 // Everything a render has sampled so far.
@@ -155,42 +96,6 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
   for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += stage.plan.counts[i];
   progress.samplesBefore += stageSamples;
   return stage;
-}
-
-// The next stage's α per pixel, and V(equal)/V(α) where the pixel's neighbours predict
-// it (GridSearchResult::varianceRatio), 1 elsewhere.
-struct StageAllocation {
-  std::vector<Allocation> allocations;
-  std::vector<float> varianceRatio;
-};
-
-// Every pixel's weights from all its samples so far, the running sums pooled over
-// its neighbourhood.
-StageAllocation allocateFromSamples(StageSampler& sampler, Method method, const AdaptiveOptions& options,
-                                    Progress& progress) {
-  const Scene& scene = sampler.scene();
-  if (methodTraits(method).searchesWeights) {
-    std::optional<PooledSelection> pooling;
-    if (options.gridRule == GridRule::MinCostVariance)
-      pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
-    GridSearchResult search = sampler.searchWeights(options.costs, options.gridRule, pooling);
-    for (size_t p = 0; p < search.skipped.size(); ++p) progress.skipped[p] &= search.skipped[p];
-    return {std::move(search.allocations), std::move(search.varianceRatio)};
-  }
-  const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = sampler.statSlots();
-  std::vector<double> stats = sampler.statistics();
-  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, options.poolRadius);
-  std::vector<float> stored = methodTraits(method).storesSamples ? sampler.storedSamples() : std::vector<float>{};
-  std::vector<Allocation> allocations(pixels);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (int p = 0; p < pixels; ++p) {
-    PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, sampler.config().statsMask, M);
-    std::optional<PixelSamples> samples;
-    if (!stored.empty())
-      samples = decodePixelSamples(stored, p, progress.samplesBefore, sampler.config().sampleCapacity, M);
-    allocations[p] = allocatePixel(method, options, pixelStats, samples ? &*samples : nullptr);
-  }
-  return {std::move(allocations), std::vector<float>(pixels, 1.0f)};
 }
 
 // The next stage's counts: the stage split by the current α. Each stage is its own
@@ -249,26 +154,67 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   return config;
 }
 
+namespace {
+
+// The allocation between the stages of `method` (alloc/StageAllocator.h), made before
+// the render's clock starts: a sampler's first grid search builds its kernels and
+// buffers, which are not render time, as the sampler's own are not.
+std::unique_ptr<StageAllocator> makeStageAllocator(StageSampler& sampler, Method method,
+                                                   const AdaptiveOptions& options) {
+  const MethodTraits& traits = methodTraits(method);
+  if (traits.searchesWeights) {
+    // The oracle's probe stands in for the true variance: rule (b) by the pixel alone.
+    const bool pooled = traits.split == Split::Staged && options.gridRule == GridRule::MinCostVariance;
+    const GridRule rule = traits.split == Split::Probed ? GridRule::MinCostVariance : options.gridRule;
+    const Scene& scene = sampler.scene();
+    std::optional<PooledSelection> pooling;
+    if (pooled) pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
+    return std::make_unique<GridSearchAllocator>(sampler, options.costs, rule, pooling);
+  }
+  PixelRule rule;
+  switch (method) {
+    case Method::Heuristic:
+      rule = PixelRule::Heuristic;
+      break;
+    case Method::SigmaSqrtC:
+      rule = PixelRule::SigmaSqrtC;
+      break;
+    case Method::Linear:
+      rule = PixelRule::Linear;
+      break;
+    default:
+      throw std::logic_error("no allocation for " + methodName(method));
+  }
+  return std::make_unique<PixelRuleAllocator>(rule, options.costs, options.poolRadius, options.linearRule);
+}
+
+}  // namespace
+
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed) {
-  auto start = Clock::now();
   const Scene& scene = sampler.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
+  const MethodTraits& traits = methodTraits(method);
   const Estimator estimator = sampler.config().estimator;
   requireValidRun(scene.options, method, estimator, spp, options);
+  std::unique_ptr<StageAllocator> allocator;
+  if (traits.adaptive()) {
+    validateCosts(options.costs, M);
+    allocator = makeStageAllocator(sampler, method, options);
+  }
+  auto start = Clock::now();
   sampler.reset();
   Rendering out;
   Progress progress(pixels, M);
-  if (!isAdaptive(method)) {
+  if (!traits.adaptive()) {
     TakenStage stage = takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false);
     accumulateStage(progress.totals, stage, estimator, std::vector<double>(pixels, 1.0));
-  } else if (methodTraits(method).split == Split::Probed) {
-    validateCosts(options.costs, M);
+  } else if (traits.split == Split::Probed) {
     // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
     // seed of its own, stands in for the true variance as a function of α; the render
     // then takes the α it finds best in one stage.
     auto probeStart = Clock::now();
     takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples, ~seed, true);
-    std::vector<Allocation> best = sampler.searchWeights(options.costs, GridRule::MinCostVariance).allocations;
+    std::vector<Allocation> best = allocator->allocate(sampler).allocations;
     out.allocationSeconds = secondsSince(probeStart);
     Progress render(pixels, M);
     render.samplesBefore = progress.samplesBefore;
@@ -276,16 +222,15 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     accumulateStage(render.totals, stage, estimator, std::vector<double>(pixels, 1.0));
     progress = std::move(render);
   } else {
-    validateCosts(options.costs, M);
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
-    if (methodTraits(method).searchesWeights && options.gridRule == GridRule::MinCostVariance)
-      std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
+    std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
     TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true);
     std::vector<double> pilotWeights;
     for (size_t b = 1; b < sizes.size(); ++b) {
       auto allocationStart = Clock::now();
-      StageAllocation next = allocateFromSamples(sampler, method, options, progress);
+      StageAllocation next = allocator->allocate(sampler);
+      for (int p = 0; p < pixels; ++p) progress.skipped[p] &= next.skipped[p];
       std::vector<int32_t> counts = stageCounts(progress, next.allocations, sizes[b]);
       out.allocationSeconds += secondsSince(allocationStart);
       if (b == 1) {
@@ -311,7 +256,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   for (size_t i = 0; i < progress.taken.size(); ++i) out.alpha[i] = double(progress.taken[i]) / spp;
   out.statisticsBytesPerPixel = double(sampler.statSlots()) * sizeof(double) +
                                 double(sampler.storedSampleCount()) * sizeof(float) / pixels +
-                                double(sampler.searchBytesPerPixel());
+                                double(allocator ? allocator->bytesPerPixel() : 0);
   out.kernelSeconds = progress.totals.kernelSeconds;
   out.devices = sampler.deviceShares();
   out.imbalanceSeconds = sampler.imbalanceSeconds();

@@ -2,9 +2,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "alloc/GridSearch.h"
 #include "alloc/LinearAllocation.h"
 #include "render/Method.h"
-#include "sampling/GridSearch.h"
 #include "sampling/Sampler.h"
 #include "scene/ExrIO.h"
 
@@ -14,8 +14,8 @@ namespace misalloc {
 struct AdaptiveOptions {
   double pilotFraction = 0.05;  // of N, split equally among the techniques
   int stages = 1;               // after the pilot
-  int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (stats/Pooling.h)
-  double minGain = 0.02;        // exact: the skip rule's least predicted gain (sampling/GridSearch.h, PooledSelection)
+  int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
+  double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
   std::vector<double> costs;    // c_k per sample, one per technique
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
@@ -51,21 +51,5 @@ struct Rendering {
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
 
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);
-
-// Estimated variance of a pixel's stage estimate from the per-technique moments of
-// its luminance values w. Balance heuristic, multi-sample: Σ_k n_k s_k² / N² ([SHS16] eq. 21
-// with estimated σ_k); one-sample: s² / N over all samples ([SHS16] Table 2);
-// count-independent weights: Σ_k s_k² / n_k ([SHS16] eq. 28).
-double stageVariance(const StagePlan& plan, const StageResult& result, int pixel, Estimator estimator);
-
-// The pilot's weight in the estimate. The stages are independent unbiased estimates,
-// best combined with weights ∝ N_b/V_b (inverse-variance weighting, V_b/N_b a stage's
-// variance as [SHS16] eq. 21 gives it). The pilot took N_0 samples at equal counts and
-// the stages after it N − N_0 at α, so with r = V(equal)/V(α) that is
-// N_0 / (N_0 + (N − N_0) r): N_0/N for r = 1, less where α beats equal counts. The
-// estimate stays unbiased because r comes from the pixel's neighbours, not from the
-// pilot it weighs, and is fixed before the stages after it (PooledSelection). A NaN
-// ratio counts as 1.
-double pilotWeight(float varianceRatio, int pilotSamples, int spp);
 
 }  // namespace misalloc

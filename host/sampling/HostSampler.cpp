@@ -32,14 +32,10 @@ HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
   share_.name = kHostSamplerName;
   if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
-  if (config.gridSize > 0)
-    gridSearch_ = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize,
-                                                        config.runningSums);
 }
 
 void HostSampler::forgetStages() {
   std::fill(stats_.begin(), stats_.end(), 0.0);
-  if (gridSearch_) gridSearch_->reset();
   share_ = share_.restarted();
 }
 

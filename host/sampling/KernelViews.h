@@ -1,7 +1,7 @@
 #pragma once
 // Host data seen through the kernels' own structs (host/KernelCode.h).
 #include "KernelCode.h"
-#include "scene/EnvmapDistribution.h"
+#include "distributions/EnvmapDistribution.h"
 
 namespace misalloc {
 

@@ -97,11 +97,6 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * 3 * accSize);
   moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
   share_.name = device.name();
-  if (config.gridSize > 0)
-    // A sub-device searches on its whole device, which shares its context and so reads
-    // the stored samples where they are: the search is not split into tiles.
-    gridSearch_ = std::make_unique<GridSearch>(device.whole ? *device.whole : device, scene.techniqueCount(),
-                                               scene.pixelCount(), config.gridSize, config.runningSums);
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
   StagePlan empty;
@@ -201,13 +196,7 @@ std::vector<DeviceShare> Sampler::deviceShares() const { return {share_}; }
 void Sampler::forgetStages() {
   const size_t bytes = size_t(scene_.pixelCount()) * statSlots() * (doubleSums_ ? sizeof(double) : sizeof(float));
   if (bytes > 0) device_.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, bytes);
-  if (gridSearch_) gridSearch_->reset();
   share_ = share_.restarted();
-}
-
-GridSearchResult Sampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                                 const std::optional<PooledSelection>& pooling) {
-  return gridSearch_->run(samples_, layout, costs, rule, pooling);
 }
 
 std::vector<float> Sampler::storedSamples() {

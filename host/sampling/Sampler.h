@@ -38,21 +38,24 @@ class Sampler : public StageSampler {
   // its own.
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
           std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+
   std::vector<double> statistics() override;
   std::vector<float> storedSamples() override;
-  std::vector<DeviceShare> deviceShares() const override;
-
- protected:  // tests/test_devices.cpp injects failures into runPixels
-  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
   void loadStatistics(const std::vector<double>& stats) override;
   void loadStoredSamples(const std::vector<float>& samples) override;
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                          const std::optional<PooledSelection>& pooling) override;
+  // A sub-device's whole device, which shares its context and so reads the stored
+  // samples where they are: a search is not split into tiles.
+  const Device* storedSampleDevice() const override { return device_.whole ? device_.whole.get() : &device_; }
+  StoredSampleBuffer storedSampleBuffer() override { return {storedSampleDevice(), &samples_, nullptr}; }
+
+  std::vector<DeviceShare> deviceShares() const override;
+
+ protected:
   void forgetStages() override;
 
  private:
   const Device& device_;
-  std::unique_ptr<GridSearch> gridSearch_;  // where config().gridSize > 0
   int localSize_;
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)

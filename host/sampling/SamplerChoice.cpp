@@ -13,12 +13,9 @@
 namespace misalloc {
 namespace {
 
-std::string mebibytes(uint64_t bytes) { return fmt::format("{:.0f} MiB", double(bytes) / (1 << 20)); }
-
-// The option that sized the sampler's largest buffers: the grid search's sums, the
-// stored samples, or else the image.
+// The option that sized the sampler's largest buffers: the stored samples, or else
+// the image.
 std::string bufferOption(const Scene& scene, const SamplerConfig& config) {
-  if (config.gridSize > 0) return fmt::format("--grid-u {}", config.gridSize);
   if (config.sampleCapacity > 0) return fmt::format("--spp (it stores {} samples per pixel)", config.sampleCapacity);
   return fmt::format("--size {}x{}", scene.grid.width, scene.grid.height);
 }
@@ -27,22 +24,11 @@ std::string bufferOption(const Scene& scene, const SamplerConfig& config) {
 // device's limit; any other error unchanged.
 DeviceError explain(const cl::Error& e, const Device& device, const Scene& scene, const SamplerConfig& config,
                     int localSize) {
-  const std::string code = fmt::format("OpenCL error {} in {}", e.err(), e.what());
-  switch (e.err()) {
-    case CL_INVALID_WORK_GROUP_SIZE:
-      return DeviceError(fmt::format("--local-size {}: {} runs at most {} work-items per work-group ({})", localSize,
-                                     device.name(), device.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>(), code));
-    case CL_INVALID_BUFFER_SIZE:
-    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
-    case CL_OUT_OF_RESOURCES:
-      return DeviceError(
-          fmt::format("{} for {} pixels: a buffer is larger than {} can hold: at most {} in one buffer, {} in all ({})",
-                      bufferOption(scene, config), scene.pixelCount(), device.name(),
-                      mebibytes(device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>()),
-                      mebibytes(device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>()), code));
-    default:
-      return DeviceError(code);
-  }
+  if (e.err() == CL_INVALID_WORK_GROUP_SIZE)
+    return DeviceError(
+        fmt::format("--local-size {}: {} runs at most {} work-items per work-group (OpenCL error {} in {})", localSize,
+                    device.name(), device.device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>(), e.err(), e.what()));
+  return explainBufferError(e, device, bufferOption(scene, config), scene.pixelCount());
 }
 
 // The envmap's sampling tables must fit the device, each in one buffer: refused

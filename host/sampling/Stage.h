@@ -1,7 +1,9 @@
 #pragma once
+#include <cstddef>
 #include <cstdint>
-#include <string>
 #include <vector>
+
+#include "Constants.h"
 
 namespace misalloc {
 
@@ -41,25 +43,6 @@ struct StageResult {
   double kernelSeconds = 0;
 };
 
-// One device's part in the stages since a sampler's reset(), for the report.
-struct DeviceShare {
-  std::string name;
-  std::string launch;         // its local size and why (cl/LaunchShape.h); empty on the host
-  long long pixelStages = 0;  // pixels it ran, summed over the stages
-  long long samples = 0;      // samples it took
-  int tiles = 0;              // kernel launches
-  double kernelSeconds = 0;   // its own device time
-  std::string failure;        // why it stopped, if it failed: its tiles ran elsewhere
-
-  // The same device with nothing run yet (StageSampler::reset).
-  DeviceShare restarted() const {
-    DeviceShare fresh;
-    fresh.name = name;
-    fresh.launch = launch;
-    return fresh;
-  }
-};
-
 // What a sampler keeps beyond the stage estimates, for the allocations.
 struct SamplerConfig {
   Estimator estimator = Estimator::MultiSample;
@@ -70,6 +53,21 @@ struct SamplerConfig {
   int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
   // The grid searches keep running sums, for renders that search more than once.
   bool runningSums = true;
+};
+
+// Where the stored samples are: the blocked float layout of kernels/stats.h
+// (storedSampleIndex), `capacity` slots per pixel of which the first `taken` are filled
+// for every pixel, pixels padded to a multiple of 16. A search reads the `taken`
+// samples as those taken since the previous search.
+struct StoredSampleLayout {
+  int pixelCount = 0;
+  int techniqueCount = 0;
+  int capacity = 0;
+  int taken = 0;
+
+  std::size_t floatCount() const {
+    return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
+  }
 };
 
 }  // namespace misalloc

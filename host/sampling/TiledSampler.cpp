@@ -164,19 +164,18 @@ void TiledSampler::loadStoredSamples(const std::vector<float>& samples) {
   std::fill(loaded_.begin(), loaded_.end(), 0);
 }
 
-GridSearchResult TiledSampler::search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                                      const std::optional<PooledSelection>& pooling) {
-  // The grid search's sums of earlier searches live on the member that ran them.
+StoredSampleBuffer TiledSampler::storedSampleBuffer() {
+  // The grid search's sums of earlier searches live on the first member's device.
   if (!live(0))
     throw DeviceError(
         fmt::format("{} runs the grid search and failed: {}", members_[0]->deviceShares().front().name, failures_[0]));
   loadMembers(1);
-  return members_[0]->search(layout, costs, rule, pooling);
+  return members_[0]->storedSampleBuffer();
 }
 
 void TiledSampler::forgetStages() {
   for (size_t d = 0; d < members_.size(); ++d)
-    if (live(d)) members_[d]->forgetStages();
+    if (live(d)) members_[d]->reset();
   loaded_.assign(members_.size(), 1);  // every member starts from zero sums, as stats_
   stats_.assign(size_t(scene_.pixelCount()) * statSlots(), 0.0);
   samples_ = config_.sampleCapacity > 0 ? emptyStoredSamples(scene_, config_.sampleCapacity) : std::vector<float>{};

@@ -25,19 +25,23 @@ class TiledSampler : public StageSampler {
   // Members built for the same scene and config, one per device.
   TiledSampler(const Scene& scene, const SamplerConfig& config, std::vector<std::unique_ptr<StageSampler>> members);
 
+  // A stage's result: the wall time from the first launch to the last finish is its
+  // kernelSeconds, the time the cost-aware allocations pay for a sample.
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
+
   std::vector<double> statistics() override { return stats_; }
   std::vector<float> storedSamples() override { return samples_; }
+  void loadStatistics(const std::vector<double>& stats) override;
+  void loadStoredSamples(const std::vector<float>& samples) override;
+  // The first member's: a search reads the samples there, where its sums of earlier
+  // searches are.
+  const Device* storedSampleDevice() const override { return members_[0]->storedSampleDevice(); }
+  StoredSampleBuffer storedSampleBuffer() override;
+
   std::vector<DeviceShare> deviceShares() const override;
   double imbalanceSeconds() const override { return imbalanceSeconds_; }
 
  private:
-  // A stage's result: the wall time from the first launch to the last finish is its
-  // kernelSeconds, the time the cost-aware allocations pay for a sample.
-  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;
-  void loadStatistics(const std::vector<double>& stats) override;
-  void loadStoredSamples(const std::vector<float>& samples) override;
-  GridSearchResult search(const StoredSampleLayout& layout, const std::vector<double>& costs, GridRule rule,
-                          const std::optional<PooledSelection>& pooling) override;
   void forgetStages() override;
 
   bool live(size_t member) const { return failures_[member].empty(); }

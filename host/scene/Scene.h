@@ -3,9 +3,9 @@
 #include <string>
 #include <vector>
 
+#include "distributions/EnvmapDistribution.h"
 #include "scene/BrdfGrid.h"
 #include "scene/Envmap.h"
-#include "scene/EnvmapDistribution.h"
 
 namespace misalloc {
 

@@ -26,9 +26,9 @@
 #include <utility>
 #include <vector>
 
+#include "alloc/GridSearch.h"
 #include "render/Method.h"
 #include "render/Render.h"
-#include "sampling/GridSearch.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
 

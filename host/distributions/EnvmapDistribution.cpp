@@ -1,4 +1,4 @@
-#include "scene/EnvmapDistribution.h"
+#include "distributions/EnvmapDistribution.h"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "Error.h"
-#include "scene/AliasTable.h"
+#include "distributions/AliasTable.h"
 
 namespace misalloc {
 namespace {

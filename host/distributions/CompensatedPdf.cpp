@@ -1,4 +1,4 @@
-#include "scene/CompensatedPdf.h"
+#include "distributions/CompensatedPdf.h"
 
 #include <fmt/format.h>
 

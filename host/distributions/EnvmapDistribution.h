@@ -3,15 +3,15 @@
 // probabilities ∝ luminance × sin θ (or its MIS-compensated form, [Kar19] eq. 14, ×
 // sin θ), and either an alias table or marginal and conditional CDFs that draw texels
 // with those probabilities; or, for the optimal pdf ([Kar19] eq. 9), a bank of such
-// tables over blocks of texels (host/scene/OptimalBank.h).
+// tables over blocks of texels (host/distributions/OptimalBank.h).
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "distributions/CompensatedPdf.h"
+#include "distributions/OptimalBank.h"
 #include "scene/BrdfGrid.h"
-#include "scene/CompensatedPdf.h"
 #include "scene/Envmap.h"
-#include "scene/OptimalBank.h"
 
 namespace misalloc {
 

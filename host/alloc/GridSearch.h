@@ -13,6 +13,7 @@
 
 #include "alloc/Allocation.h"
 #include "cl/Device.h"
+#include "sampling/Stage.h"
 
 namespace misalloc {
 
@@ -51,26 +52,13 @@ WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::ve
 // rule and the pooling are kernel arguments: one program serves them all.
 std::string gridSearchKernelOptions(int techniqueCount);
 
-// Where the stored samples are: the blocked float layout of kernels/stats.h
-// (storedSampleIndex), `capacity` slots per pixel of which the first `taken` are filled
-// for every pixel, pixels padded to a multiple of 16. A search reads the `taken`
-// samples as those taken since the previous search.
-struct StoredSampleLayout {
-  int pixelCount = 0;
-  int techniqueCount = 0;
-  int capacity = 0;
-  int taken = 0;
-
-  std::size_t floatCount() const;
-};
-
 // What a search keeps per pixel from run to run: Σ g and Σ g² for every technique and
 // combination (the grid padded to whole passes) where it keeps running sums, the
 // summary of the samples, and the last search's scores and scale for the pooled
 // selection.
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums);
 
-// Rule (b)'s selection over neighbourhoods (stats/Pooling.h says why) and the skip
+// Rule (b)'s selection over neighbourhoods (Pooling.h says why) and the skip
 // rule, for the pixels of a width × height image: each pixel takes the combination
 // with the least Σ_q (Σ_k c_k α_k) V_q over the ranked pixels q within `radius`, and
 // keeps equal weights where that is not at least the fraction `minGain` below its

@@ -1,4 +1,4 @@
-#include "sampling/GridSearch.h"
+#include "alloc/GridSearch.h"
 
 #include <fmt/format.h>
 
@@ -408,10 +408,6 @@ WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::ve
 
 std::string gridSearchKernelOptions(int techniqueCount) {
   return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors);
-}
-
-std::size_t StoredSampleLayout::floatCount() const {
-  return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
 }
 
 std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums) {

@@ -1,4 +1,4 @@
-#include "stats/Pooling.h"
+#include "alloc/Pooling.h"
 
 #include <algorithm>
 #include <stdexcept>

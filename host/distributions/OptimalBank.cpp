@@ -1,10 +1,10 @@
-#include "scene/OptimalBank.h"
+#include "distributions/OptimalBank.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "KernelCode.h"
-#include "scene/CompensatedPdf.h"
+#include "distributions/CompensatedPdf.h"
 
 namespace misalloc {
 namespace {

@@ -1,4 +1,4 @@
-#include "scene/AliasTable.h"
+#include "distributions/AliasTable.h"
 
 #include <algorithm>
 #include <cmath>

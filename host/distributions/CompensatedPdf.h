@@ -3,7 +3,7 @@
 // MIS, the envmap pdf should cover what BRDF sampling leaves uncovered, not the whole
 // radiance. The practical, normal-independent form ([Kar19] eq. 14) subtracts a
 // constant from the luminance before tabulating it. The general forms (eqs. 5–10) are
-// here too: host/scene/OptimalBank.h tabulates them per BRDF, host/paper/Flatland.h
+// here too: host/distributions/OptimalBank.h tabulates them per BRDF, host/paper/Flatland.h
 // reproduces the paper's 1D test with them.
 #include <cstddef>
 #include <string>
@@ -13,7 +13,7 @@ namespace misalloc {
 
 // The shape of the envmap technique's pdf (`--envmap-pdf`).
 // `Optimal` is [Kar19] eq. 9 for each pixel's own BRDF and envmap share (a bank of
-// tables, host/scene/OptimalBank.h).
+// tables, host/distributions/OptimalBank.h).
 struct EnvmapPdf {
   enum class Kind { Plain, Compensated, Optimal };
   Kind kind = Kind::Plain;

@@ -3,10 +3,17 @@
 // The grids of BRDF parameters vary smoothly across the image, as real surfaces do, so
 // neighbouring pixels want nearly the same α, while one pixel's pilot of a few samples
 // per technique misjudges the variance of a small bright source by large factors.
-// Pooling changes only which α a stage uses, so it keeps every stage unbiased. The grid
-// search's pooled selection also predicts how much better that α is than equal counts,
-// which weighs the pilot (render/Render.h, pilotWeight): it leaves the pixel's own
-// samples out for that (sampling/GridSearch.h, PooledSelection).
+// Pooling changes only which α a stage uses, so it keeps every stage unbiased.
+//
+// The per-pixel rules (PixelRuleAllocator.h) pool here, on the host, the running sums
+// their formulas read, the pixel's own included. The grid search pools something else
+// in its own kernel (kernels/gridsearch.cl, selectPooled, whose C++ reference is
+// selectPooledPixel in GridSearch.cpp): the scores of each weight combination, each pixel's brought to a
+// common scale, and without the pixel itself, because that selection also predicts how
+// much better its α is than equal counts, which weighs the pilot (StageWeights.h,
+// pilotWeight), and the prediction must not rest on the pilot it weighs
+// (GridSearch.h, PooledSelection). The two share only the window's shape, (2r + 1)²
+// pixels clipped at the image's edges.
 
 #include <vector>
 

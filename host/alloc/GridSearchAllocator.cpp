@@ -1,0 +1,63 @@
+#include "alloc/GridSearchAllocator.h"
+
+#include <fmt/format.h>
+
+#include <memory>
+#include <stdexcept>
+
+namespace misalloc {
+namespace {
+
+// The search a sampler keeps (StageStatistics::kept): on the device that holds its stored
+// samples, else the C++ reference on the host.
+struct KeptGridSearch final : StageStatistics::Kept {
+  std::unique_ptr<GridSearch> device;
+  std::unique_ptr<GridSearchReference> host;
+
+  GridSearchResult run(const StoredSamples& stored, const std::vector<double>& costs, GridRule rule,
+                       const std::optional<PooledSelection>& pooling) {
+    if (device) return device->run(*stored.where.buffer, stored.layout, costs, rule, pooling);
+    return host->run(*stored.where.host, stored.layout, costs, rule, pooling);
+  }
+  void reset() { device ? device->reset() : host->reset(); }
+};
+
+KeptGridSearch& keptSearch(StageStatistics& stages) {
+  if (auto* kept = dynamic_cast<KeptGridSearch*>(stages.kept().get())) return *kept;
+  const Scene& scene = stages.scene();
+  const SamplerConfig& config = stages.config();
+  auto kept = std::make_unique<KeptGridSearch>();
+  if (const Device* device = stages.storedSampleDevice()) {
+    try {
+      kept->device = std::make_unique<GridSearch>(*device, scene.techniqueCount(), scene.pixelCount(), config.gridSize,
+                                                  config.runningSums);
+    } catch (const cl::Error& e) {
+      // The grid's sums and scores are the search's largest buffers.
+      throw explainBufferError(e, *device, fmt::format("--grid-u {}", config.gridSize), scene.pixelCount());
+    }
+  } else {
+    kept->host = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize,
+                                                       config.runningSums);
+  }
+  stages.kept() = std::move(kept);
+  return static_cast<KeptGridSearch&>(*stages.kept());
+}
+
+}  // namespace
+
+GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, std::vector<double> costs, GridRule rule,
+                                         std::optional<PooledSelection> pooling)
+    : costs_(std::move(costs)), rule_(rule), pooling_(pooling) {
+  const SamplerConfig& config = stages.config();
+  if (config.gridSize <= 0 || config.sampleCapacity <= 0)
+    throw std::logic_error("grid search on a sampler that does not keep what it needs");
+  keptSearch(stages).reset();
+  bytesPerPixel_ = gridSearchBytesPerPixel(stages.scene().techniqueCount(), config.gridSize, config.runningSums);
+}
+
+StageAllocation GridSearchAllocator::allocate(StageStatistics& stages) {
+  GridSearchResult search = keptSearch(stages).run(stages.takeStoredSamples(), costs_, rule_, pooling_);
+  return {std::move(search.allocations), std::move(search.varianceRatio), std::move(search.skipped)};
+}
+
+}  // namespace misalloc

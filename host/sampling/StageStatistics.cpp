@@ -1,0 +1,72 @@
+#include "sampling/StageStatistics.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "KernelCode.h"
+
+namespace misalloc {
+
+StageStatistics::StageStatistics(const Scene& scene, const SamplerConfig& config) : scene_(scene), config_(config) {
+  if (config.sampleCapacity < 0) throw std::invalid_argument("negative sample capacity");
+  if (config.estimator == Estimator::OneSample &&
+      (config.statsMask != 0 || config.sampleCapacity > 0 || config.gridSize > 0))
+    throw std::invalid_argument("the allocations' statistics are kept for the multi-sample estimators only");
+}
+
+int StageStatistics::statSlots() const {
+  return scene_.techniqueCount() * MA_STATS_PER_TECHNIQUE(int(config_.statsMask), scene_.techniqueCount());
+}
+
+size_t StageStatistics::storedSampleCount() const {
+  return StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, 0}.floatCount();
+}
+
+int StageStatistics::takeSlots(const StagePlan& plan) {
+  if (closed_) throw std::logic_error("a stage after the stage without statistics");
+  if (!plan.keepStatistics) {
+    closed_ = true;
+    return 0;
+  }
+  const int slot = plan.samplesBefore - searched_;
+  if (slot < 0) throw std::logic_error("stage overwrites samples the grid search already added");
+  if (config_.sampleCapacity > 0 && slot + plan.stageSamples > config_.sampleCapacity)
+    throw std::logic_error("stage overflows the stored-samples buffer");
+  taken_ = plan.samplesBefore + plan.stageSamples;
+  return slot;
+}
+
+void StageStatistics::forgetSlots() {
+  taken_ = searched_ = 0;
+  closed_ = false;
+}
+
+StoredSamples StageStatistics::takeStoredSamples() {
+  if (config_.sampleCapacity <= 0) throw std::logic_error("a search on a sampler that stores no samples");
+  StoredSamples stored{
+      StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken_ - searched_},
+      storedSampleBuffer()};
+  searched_ = taken_;
+  return stored;
+}
+
+std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
+  const int M = scene.techniqueCount();
+  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), M, capacity, 0}.floatCount(), 1.0f);
+  for (size_t record = 0; record < samples.size() / 16; ++record) {
+    int q = int(record % size_t(M + 2));
+    if (q < 2) std::fill_n(samples.begin() + record * 16, 16, 0.0f);
+  }
+  return samples;
+}
+
+bool keepsStatistics(const SamplerConfig& config) { return config.statsMask != 0 || config.sampleCapacity > 0; }
+
+SamplerConfig plainConfig(SamplerConfig config) {
+  config.statsMask = 0;
+  config.sampleCapacity = 0;
+  config.gridSize = 0;
+  return config;
+}
+
+}  // namespace misalloc
