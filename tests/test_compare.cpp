@@ -77,7 +77,7 @@ TEST_CASE("the speed-up over equal at equal error is the ratio of efficiencies u
 
 TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out", "[compare]") {
   Comparison c;
-  c.cases.push_back({"a", {}, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
+  c.cases.push_back({"a", {}, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", 0, "test"});
   for (int budget : {10, 20}) {
     for (int r = 0; r < 2; ++r) {
       // RMSE×1000 = 100 ± 10 (budget 10) and an exact 1/t law for equal.

@@ -301,7 +301,7 @@ TEST_CASE("compare runs each scene with each envmap pdf and compares them with e
   for (const char* pdf : {"plain", "compensated:0.5"}) {
     nlohmann::json scene = {{"envmap", "m"}, {"envmap_pdf", {{"requested", pdf}}}};
     const std::string label = std::string("m-") + pdf;
-    c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", "test"});
+    c.cases.push_back({label, scene, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", 0, "test"});
     for (int budget : {10, 20})
       c.runs.push_back(record(label, Method::Equal, budget, 0, 0.01 * budget,
                               (pdf == std::string("plain") ? 1e-4 : 0.5e-4) * 10 / budget));

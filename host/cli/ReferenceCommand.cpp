@@ -33,10 +33,8 @@ int runReference(ReferenceArgs& args) {
   Scene scene = args.scene.make();
   if (auto cached = referenceCachePath(scene, args.spp, args.cacheDir))
     outputs.addInput({"the cached reference (--cache-dir)", *cached});
-  std::unique_ptr<StageSampler> sampler;
-  Reference reference = findReference(scene, args.spp, args.cacheDir, [&]() -> StageSampler& {
-    sampler = args.devices.makeSampler(scene, SamplerConfig{}, kDefaultLocalSize);
-    return *sampler;
+  Reference reference = findReference(scene, args.spp, args.cacheDir, [&](const Scene& s) {
+    return args.devices.makeSampler(s, SamplerConfig{}, kDefaultLocalSize);
   });
   if (!args.out.empty()) outputs.put(args.out, encodeExr(reference.image));
   outputs.commit();

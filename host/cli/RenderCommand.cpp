@@ -83,7 +83,7 @@ int runRender(RenderArgs& args) {
   std::string deviceName = args.devices.name();
   SceneBasis basis = findSceneBasis(
       plainScene, {args.reference == "auto", args.referenceSpp, args.cacheDir, traits.adaptive(), adaptive.costs},
-      [&] { return args.devices.makeSampler(plainScene, SamplerConfig{}, args.localSize); });
+      [&](const Scene& s) { return args.devices.makeSampler(s, SamplerConfig{}, args.localSize); });
   if (basis.reference) reference = std::move(basis.reference);
   adaptive.costs = basis.costs;
   Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);

@@ -79,6 +79,7 @@ nlohmann::json caseJson(const CaseInfo& c) {
           {"costs_s_per_sample", c.costs},
           {"costs_source", c.costSource},
           {"reference", c.referenceSource},
+          {"reference_variance", c.referenceVariance},
           {"device", c.device}};
 }
 
@@ -148,12 +149,14 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
         fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
     SceneBasis basis = findSceneBasis(
         plainScene, {true, options.referenceSpp, options.cacheDir, true, options.adaptive.costs},
-        [&] { return devices.makeSampler(plainScene, SamplerConfig{}, options.localSize); });
+        [&](const Scene& s) { return devices.makeSampler(s, SamplerConfig{}, options.localSize); });
     const std::optional<Reference>& reference = basis.reference;
     AdaptiveOptions adaptive = options.adaptive;
     adaptive.costs = basis.costs;
+    double referenceVariance = 0;
+    for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, devices.name()});
+                         reference->source, referenceVariance, devices.name()});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);

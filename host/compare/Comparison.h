@@ -62,6 +62,7 @@ struct CaseInfo {
   std::vector<double> costs;
   std::string costSource;  // "measured" or "--cost"
   std::string referenceSource;
+  double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;
 };
 

@@ -18,6 +18,9 @@ namespace misalloc {
 namespace fs = std::filesystem;
 namespace {
 
+constexpr uint32_t kReferenceFirstIndex = 1u << 31;
+constexpr uint64_t kReferenceSeed = 0x8000000000005eedull;
+
 // FNV-1a, 64 bits: a stable content hash for cache keys.
 struct Fnv1a {
   uint64_t h = 0xcbf29ce484222325ull;
@@ -48,6 +51,16 @@ std::optional<RgbImage> analyticReference(const Scene& scene) {
   return image;
 }
 
+Scene referenceScene(const Scene& scene) {
+  SceneOptions options = scene.options;
+  options.envmapPdf = options.splitBrdf ? EnvmapPdf{} : parseEnvmapPdf("optimal");
+  return makeScene(options);
+}
+
+std::string referenceEstimator(const SceneOptions& scene) {
+  return fmt::format("equal-count MIS, {} envmap pdf", scene.splitBrdf ? "plain" : "optimal");
+}
+
 SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
                                  const std::function<void(int done, int spp)>& progress) {
   constexpr int kMaxBatch = 4096, kBatches = 16;
@@ -59,7 +72,9 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
   const int batches = std::max(std::min(kBatches, spp / M), (spp + kMaxBatch - 1) / kMaxBatch);
   // Per pixel and channel: Σ_b n_b x_b and Σ_b n_b x_b² over the batches' estimates x_b.
   std::vector<double> sum(size_t(pixels) * 3, 0.0), sumSquares(sum.size(), 0.0);
-  std::vector<uint32_t> taken(size_t(pixels) * M, 0);
+  // Sample indices from 2³¹ on: a render's never reach them (its spp is an int), so
+  // the reference's random numbers are its own whatever the render's seed.
+  std::vector<uint32_t> taken(size_t(pixels) * M, kReferenceFirstIndex);
   for (int b = 0, done = 0; b < batches; ++b) {
     const int n = spp / batches + (b < spp % batches ? 1 : 0);
     StagePlan plan = singleStagePlan(scene, Method::Equal, n);
@@ -102,6 +117,7 @@ std::string referenceKey(const Scene& scene, int spp) {
   h.addValue(scene.options.viewTheta);
   h.addValue(scene.options.viewPhi);
   h.addValue(spp);
+  h.add(referenceEstimator(scene.options));
   return fmt::format("{:016x}", h.h);
 }
 
@@ -119,8 +135,6 @@ std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const
 
 namespace {
 
-constexpr const char* kReferenceEstimator = "equal-count MIS, plain envmap pdf";
-
 // The cache entry's channels: the image, then the standard deviation of its error.
 const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_error.G", "standard_error.B"};
 
@@ -134,7 +148,7 @@ uint64_t pixelChecksum(const SampledReference& reference) {
 // What a cache entry says it is; the checksum is of its pixels as read.
 ExrAttributes cacheClaims(const Scene& scene, int spp, const SampledReference& reference) {
   return {{"misalloc.reference.key", referenceKey(scene, spp)},
-          {"misalloc.reference.estimator", kReferenceEstimator},
+          {"misalloc.reference.estimator", referenceEstimator(scene.options)},
           {"misalloc.reference.spp", std::to_string(spp)},
           {"misalloc.reference.size", fmt::format("{}x{}", scene.grid.width, scene.grid.height)},
           {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(reference))}};
@@ -188,11 +202,10 @@ void reportProgress(int done, int spp) {
 
 }  // namespace
 
-Reference findReference(const Scene& scene, int spp, const std::string& cacheDir,
-                        const std::function<StageSampler&()>& sampler) {
+Reference findReference(const Scene& scene, int spp, const std::string& cacheDir, const SamplerFactory& makeSampler) {
   if (auto analytic = analyticReference(scene)) return Reference{*analytic, {}, "analytic ([HS14] eq. 6.17)", ""};
   const std::string path = *referenceCachePath(scene, spp, cacheDir);
-  const std::string source = fmt::format("{}, {} spp", kReferenceEstimator, spp);
+  const std::string source = fmt::format("{}, {} spp", referenceEstimator(scene.options), spp);
   std::string recomputed;
   std::error_code ec;
   if (fs::exists(path, ec)) {
@@ -209,10 +222,11 @@ Reference findReference(const Scene& scene, int spp, const std::string& cacheDir
     throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, fs::path(path).parent_path().string(),
                                  ec.message()));
   std::cerr << fmt::format("misalloc: computing the reference ({}, {} spp, {}x{} pixels) once; it is cached in {}\n",
-                           kReferenceEstimator, spp, scene.grid.width, scene.grid.height,
+                           referenceEstimator(scene.options), spp, scene.grid.width, scene.grid.height,
                            fs::path(path).parent_path().string());
-  // A seed of its own (top bit set), so a render with a small seed is independent of it.
-  SampledReference sampled = sampleReference(sampler(), scene, spp, 0x8000000000005eedull, reportProgress);
+  const Scene sampledScene = referenceScene(scene);
+  std::unique_ptr<StageSampler> sampler = makeSampler(sampledScene);
+  SampledReference sampled = sampleReference(*sampler, sampledScene, spp, kReferenceSeed, reportProgress);
   writeFileAtomically(path, encodeCacheEntry(scene, spp, sampled));
   return Reference{std::move(sampled.image), std::move(sampled.standardError), source + recomputed, path};
 }

@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 #include <string>
@@ -31,6 +32,16 @@ struct SampledReference {
 // ρs(n+2)/(n+K+2)), exact. Empty for any other scene.
 std::optional<RgbImage> analyticReference(const Scene& scene);
 
+// The scene whose estimator a sampled reference of `scene` runs: equal counts with the
+// optimal envmap pdf ([Kar19] eq. 9, the table for C = 1/2), the best unbiased
+// estimator misalloc has, or with the plain pdf where the optimal one is not
+// implemented (the BRDF split into lobes). Reads the envmap again: built only when a
+// reference is computed.
+Scene referenceScene(const Scene& scene);
+
+// What referenceScene's estimator is, in words, for the cache entry and the reports.
+std::string referenceEstimator(const SceneOptions& scene);
+
 // A converged image: equal-count MIS with `spp` samples per pixel, in independent
 // batches of at most 4096 samples (no kernel launch runs for long) and at least M, at
 // most 16 of them where the budget allows: the spread of the batches' estimates gives
@@ -40,8 +51,8 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
                                  const std::function<void(int done, int spp)>& progress = {});
 
 // The cache key of a scene's reference: everything the pixel values depend on (the
-// envmap's texels, the analytic exponent, the grid, size and view) and the spp, not
-// the techniques or the sampler.
+// envmap's texels, the analytic exponent, the grid, size and view), the spp and the
+// estimator (referenceEstimator), not the pdf the render asked for or the sampler.
 std::string referenceKey(const Scene& scene, int spp);
 
 // $MISALLOC_CACHE_DIR, else $XDG_CACHE_HOME/misalloc, else ~/.cache/misalloc.
@@ -52,13 +63,14 @@ std::string defaultCacheDir();
 // output may be written over it.
 std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir);
 
-// The analytic reference if there is one, else the cached one, else a sampled one,
-// which is then cached; `sampler` (without statistics) is asked for only then. A cache
+// The analytic reference if there is one, else the cached one, else a sampled one of
+// referenceScene(scene), which is then cached; `makeSampler` (a sampler without
+// statistics for the scene it is given) is called only then. A cache
 // entry carries in its header what it claims to be (the scene's key, the estimator,
 // spp, size) and a checksum of its pixels; one that cannot be read, or whose claims or
 // checksum do not match, is never trusted: it is reported on stderr and in the source,
 // and computed again. Progress of a computation goes to stderr.
-Reference findReference(const Scene& scene, int spp, const std::string& cacheDir,
-                        const std::function<StageSampler&()>& sampler);
+using SamplerFactory = std::function<std::unique_ptr<StageSampler>(const Scene&)>;
+Reference findReference(const Scene& scene, int spp, const std::string& cacheDir, const SamplerFactory& makeSampler);
 
 }  // namespace misalloc

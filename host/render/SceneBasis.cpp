@@ -4,19 +4,13 @@
 
 namespace misalloc {
 
-SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& request,
-                          const std::function<std::unique_ptr<StageSampler>()>& makePlainSampler) {
-  std::unique_ptr<StageSampler> plain;
-  auto plainSampler = [&]() -> StageSampler& {
-    if (!plain) plain = makePlainSampler();
-    return *plain;
-  };
+SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& request, const SamplerFactory& makeSampler) {
   SceneBasis basis;
   if (request.findReference)
-    basis.reference = findReference(plainScene, request.referenceSpp, request.cacheDir, plainSampler);
+    basis.reference = findReference(plainScene, request.referenceSpp, request.cacheDir, makeSampler);
   if (!request.needsCosts) return basis;
   basis.costSource = request.givenCosts.empty() ? "measured" : "--cost";
-  basis.costs = request.givenCosts.empty() ? measureCosts(plainSampler()) : request.givenCosts;
+  basis.costs = request.givenCosts.empty() ? measureCosts(*makeSampler(plainScene)) : request.givenCosts;
   return basis;
 }
 

@@ -28,9 +28,9 @@ struct SceneBasisRequest {
 
 // The reference and the costs of `plainScene` (the scene with the plain envmap pdf:
 // [Kar19]'s pdf changes the noise, not the integral, so one reference and one cost
-// measurement serve every pdf). `makePlainSampler` builds a sampler without statistics
-// for them, only if one is needed (no analytic reference, or costs to measure).
-SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& request,
-                          const std::function<std::unique_ptr<StageSampler>()>& makePlainSampler);
+// measurement serve every pdf). `makeSampler` builds a sampler without statistics for
+// the scene it is given, only where one is needed (a reference to compute, costs to
+// measure).
+SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& request, const SamplerFactory& makeSampler);
 
 }  // namespace misalloc
