@@ -3,8 +3,8 @@
 // same pdf: an O(1) alias table and marginal/conditional CDFs with binary searches.
 // With the optimal pdf ([Kar19] eq. 9), a bank of tables over blocks of texels, one
 // per BRDF bin and envmap share, picks the block, and the plain pdf the texel in it.
-// Host side: host/scene/Envmap.h, host/scene/EnvmapDistribution.h,
-// host/scene/OptimalBank.h.
+// Host side: host/scene/Envmap.h, host/distributions/EnvmapDistribution.h,
+// host/distributions/OptimalBank.h.
 #include "namespace_check.h"
 #ifndef MA_ENVMAP_H
 #define MA_ENVMAP_H

@@ -1,6 +1,6 @@
 // Why a pixel's allocation fell back to a defensive rule: the bits of
 // host/alloc/Allocation.h's AllocationFallback (kFallback*, which must equal these;
-// host/sampling/GridSearch.cpp checks it), one place for the kernels and the host. The
+// host/alloc/GridSearch.cpp checks it), one place for the kernels and the host. The
 // grid-search kernel sets the first five; the last two come from host-only rules.
 #include "namespace_check.h"
 #ifndef MA_FALLBACKS_H

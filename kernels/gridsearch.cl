@@ -2,7 +2,7 @@
 // pixels adds the samples that kernels/sample.cl stored since the previous search
 // (kernels/stats.h, storedSampleIndex) to the pixel's running sums for the U weight
 // combinations, 16 of them per float16, and selects from the sums. Host side and C++
-// reference: host/sampling/GridSearch.h. What both share: kernels/gridsearch.h.
+// reference: host/alloc/GridSearch.h. What both share: kernels/gridsearch.h.
 //
 // Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M) and
 // MA_GRID_VECTORS (B), the float16s of combinations summed in one pass over the samples.
@@ -221,7 +221,7 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
 // (M floats), the selected index l₀ (−1 where the pixel fell back to equal weights),
 // AllocationFallback bits, the score of every combination (paddedSize floats; written
 // where the pixel did not fall back) and the scale of its sums (sampleScale), so that
-// the host can pool the scores of neighbouring pixels (host/sampling/GridSearch.h, PooledSelection).
+// the host can pool the scores of neighbouring pixels (host/alloc/GridSearch.h, PooledSelection).
 __kernel void gridSearch(__global const float* samples, int capacity, int taken, int pixelCount,
                          __global const float* gridLanes, __global const float* gridCost, int gridSize, int paddedSize,
                          __global const float* cost, int rule, __global float* prepared,
@@ -308,7 +308,7 @@ __kernel void selectPooled(__global const float* scores, __global const float* s
     // A pass of MA_PASS combinations per visit of a neighbour: its factor once, and
     // MA_GRID_VECTORS independent chains. Each lane is Σ_q score_q,l · (scaleMin/scale_q)²
     // over the window's pooled pixels q in row-major order, one fma chain, as the
-    // reference's pooledScore (host/sampling/GridSearch.cpp).
+    // reference's pooledScore (host/alloc/GridSearch.cpp).
     for (int l0 = 0; l0 < gridSize; l0 += MA_PASS) {
       float16 sum[MA_GRID_VECTORS];
       MA_UNROLL

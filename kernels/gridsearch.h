@@ -1,5 +1,5 @@
 // [HS14]'s Algorithm 1 ("exact" allocation) for one pixel: everything the OpenCL
-// kernel (kernels/gridsearch.cl) and its C++ reference (host/sampling/GridSearch.cpp)
+// kernel (kernels/gridsearch.cl) and its C++ reference (host/alloc/GridSearch.cpp)
 // share, so that both compute bit for bit the same sums and rank the weight
 // combinations with the same code. Only the loop over samples × combinations is each
 // side's own: float16 over 16 combinations in the kernel, plain loops in C++.
@@ -276,7 +276,7 @@ MA_FN float gridScore(int rule, int techniqueCount, const float* alpha, float me
                                      : costVarianceScore(techniqueCount, alpha, meanCost, sumG, sumG2[0], invTotal);
 }
 
-// Pooled selection (host/stats/Pooling.h says why): a pixel ranks the combinations by
+// Pooled selection (host/alloc/Pooling.h says why): a pixel ranks the combinations by
 // the sum of its neighbours' scores, each brought from its own scale to the smallest
 // scale in the window, so that no factor exceeds 1 and the sum cannot overflow.
 MA_FN float poolingFactor(float scaleMin, float scale) {
@@ -287,7 +287,7 @@ MA_FN float poolingFactor(float scaleMin, float scale) {
 // The window of radius r around pixel (x, y), clipped at the image's edges. For r > 0
 // it leaves the pixel itself out: its α and its pilot's weight then come from its
 // neighbours' samples only, so that the weight is independent of the pilot it weighs
-// (host/render/Render.h, pilotWeight).
+// (host/alloc/StageWeights.h, pilotWeight).
 typedef struct {
   int x0, x1, y0, y1;
   int self;  // the pixel left out, −1 for none
