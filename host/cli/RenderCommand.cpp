@@ -54,6 +54,7 @@ int runRender(RenderArgs& args) {
   const Method m = parseMethod(args.method);
   const MethodTraits& traits = methodTraits(m);
   const Estimator estimator = parseEstimator(args.estimator);
+  if (m == Method::Envmap) args.scene.usePlainPdfByDefault();  // the optimal pdf does not cover f alone
   std::vector<NamedFile> inputs = envmapInputs({args.scene.parsed()});
   if (args.reference != "auto" && args.reference != "none") inputs.push_back({"--reference", args.reference});
   OutputSet outputs(inputs);

@@ -31,11 +31,16 @@ void SceneArgs::add(CLI::App& command) {
 }
 
 void SceneArgs::addEnvmapPdf(CLI::App& command) {
-  command
-      .add_option("--envmap-pdf", envmapPdf,
-                  "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C "
-                  "default 0.5) or optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables)")
-      ->capture_default_str();
+  envmapPdf = "optimal";
+  envmapPdfOption = command.add_option(
+      "--envmap-pdf", envmapPdf,
+      "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C default 0.5) or "
+      "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables); default optimal, plain with "
+      "--split-brdf or --method envmap");
+}
+
+void SceneArgs::usePlainPdfByDefault() {
+  if (envmapPdfOption && envmapPdfOption->count() == 0) envmapPdf = "plain";
 }
 
 SceneOptions SceneArgs::parsed() {
@@ -48,7 +53,8 @@ SceneOptions SceneArgs::parsed() {
   options.viewTheta = angles[0];
   options.viewPhi = angles.size() > 1 ? angles[1] : 0;
   options.sampler = parseEnvmapSampler(sampler);
-  options.envmapPdf = parseEnvmapPdf(envmapPdf);
+  const bool defaultPdf = envmapPdfOption && envmapPdfOption->count() == 0;
+  options.envmapPdf = parseEnvmapPdf(defaultPdf && options.splitBrdf ? "plain" : envmapPdf);
   return options;
 }
 

@@ -11,10 +11,14 @@ namespace misalloc {
 struct SceneArgs {
   SceneOptions options;
   std::string size = "128x128", view = "0", sampler = "alias", envmapPdf = "plain";
+  CLI::Option* envmapPdfOption = nullptr;
 
   void add(CLI::App& command);
-  // [Kar19]: render only; a reference is equal MIS with the plain pdf, compare takes a list.
+  // [Kar19]: render only; compare takes a list. Its default is the optimal pdf, the
+  // largest gain misalloc has, or the plain one where the optimal one cannot serve:
+  // with --split-brdf (not implemented) and for envmap sampling alone (usePlainPdfByDefault).
   void addEnvmapPdf(CLI::App& command);
+  void usePlainPdfByDefault();
 
   // The options with --size, --view, --envmap-sampler and --envmap-pdf parsed; throws
   // InputError.
