@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "CliRunner.h"
 #include "scene/ExrIO.h"
@@ -43,6 +44,25 @@ inline void writeText(const fs::path& path, const std::string& text) { std::ofst
 inline std::string readText(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A run that must be refused with exit 2 and a message holding `expected`.
+struct Refusal {
+  std::string args, expected;
+};
+
+// Runs each refusal and checks that it leaves every file under `dir` as it was and,
+// when `untouched` is given, that this path was never created.
+inline void checkRefusals(const fs::path& dir, const std::vector<Refusal>& refusals, const fs::path& untouched = {}) {
+  const std::string before = fingerprint(dir);
+  for (const Refusal& c : refusals) {
+    auto r = runMisalloc(c.args);
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.exitCode == 2);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    if (!untouched.empty()) CHECK_FALSE(fs::exists(untouched));
+    CHECK(fingerprint(dir) == before);
+  }
 }
 
 // A small valid envmap, its links, and earlier outputs that a failed run must keep.

@@ -32,10 +32,7 @@ TEST_CASE("an output that is an input, or another output, is refused and nothing
   Workspace w;
   const std::string env = w.path("env.exr");
   fs::copy_file(env, w.path("map.png"));  // an envmap that an α map's PNG would replace
-  struct Case {
-    std::string args, expected;
-  };
-  const Case cases[] = {
+  const std::vector<Refusal> cases = {
       {w.render("--out " + env), "--out " + env + " is the same file as --envmap"},
       {w.render(fmt::format("--out {}/./env.exr", w.dir.path.string())), "is the same file as --envmap"},
       {w.render(fmt::format("--out {}/sub/../env.exr", w.dir.path.string())), "is the same file as --envmap"},
@@ -59,14 +56,7 @@ TEST_CASE("an output that is an input, or another output, is refused and nothing
                    w.path("cache"), w.path("link.exr")),
        "is the same file as --envmap"},
   };
-  const std::string before = fingerprint(w.dir.path);
-  for (const Case& c : cases) {
-    auto r = runMisalloc(c.args);
-    INFO(c.args << "\n" << r.output);
-    CHECK(r.exitCode == 2);
-    CHECK(r.output.find(c.expected) != std::string::npos);
-    CHECK(fingerprint(w.dir.path) == before);
-  }
+  checkRefusals(w.dir.path, cases);
   CHECK_FALSE(holdsTemporaries(w.dir.path));
 }
 
@@ -396,10 +386,7 @@ TEST_CASE("refusals that the options alone decide come before any work", "[cli][
   const std::string compare = fmt::format(
       "compare --size 4x4 --methods equal --budgets 4 --repeats 1 --device cpu --reference-spp 20000 --cache-dir {}",
       cache);
-  struct Case {
-    std::string args, expected;
-  };
-  const Case cases[] = {
+  const std::vector<Refusal> cases = {
       {fmt::format("{} --envmap {} --out-dir {}", compare, (od / "map.exr").string(), od.string()),
        "lies inside --out-dir"},
       {fmt::format("{} --envmap {} --out-dir {} --cache-dir {}", compare, w.path("env.exr"), w.path("od2"),
@@ -417,15 +404,7 @@ TEST_CASE("refusals that the options alone decide come before any work", "[cli][
       {w.render("--method exact --grid-rule entropy --spp 40 --reference auto --cache-dir " + cache),
        "give --pool 0"},
   };
-  const std::string before = fingerprint(w.dir.path);
-  for (const Case& c : cases) {
-    auto r = runMisalloc(c.args);
-    INFO(c.args << "\n" << r.output);
-    CHECK(r.exitCode == 2);
-    CHECK(r.output.find(c.expected) != std::string::npos);
-    CHECK_FALSE(fs::exists(cache));  // no reference computed, no cache entry written
-    CHECK(fingerprint(w.dir.path) == before);
-  }
+  checkRefusals(w.dir.path, cases, cache);  // no reference computed, no cache entry written
 }
 
 TEST_CASE("every example that `misalloc paper` lists runs", "[cli][paper]") {
