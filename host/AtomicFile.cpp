@@ -6,12 +6,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
-#include <regex>
 #include <set>
 
 #include "Error.h"
@@ -39,6 +39,20 @@ size_t nameLimit(const fs::path& folder) {
 
 bool processRuns(long pid) { return ::kill(pid_t(pid), 0) == 0 || errno != ESRCH; }
 
+bool allDigits(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// The PID in a temporary's name, ".NAME.tmp-PID-ATTEMPT" (temporaryName), or -1.
+long temporaryOwner(const std::string& name) {
+  const size_t tag = name.rfind(".tmp-");
+  if (name.empty() || name[0] != '.' || tag == std::string::npos || tag == 0) return -1;
+  const std::string rest = name.substr(tag + 5);
+  const size_t dash = rest.find('-');
+  if (dash == std::string::npos || !allDigits(rest.substr(0, dash)) || !allDigits(rest.substr(dash + 1))) return -1;
+  return dash > 9 ? -1 : std::stol(rest.substr(0, dash));
+}
+
 }  // namespace
 
 std::string temporaryName(const std::string& path, int attempt) {
@@ -65,13 +79,10 @@ void removeStaleTemporaries(const std::string& folder) {
     std::lock_guard<std::mutex> lock(mutex);
     if (!cleaned.insert(fs::absolute(dir, ec).lexically_normal().string()).second) return;
   }
-  static const std::regex temporary(R"(\..*\.tmp-([0-9]+)-[0-9]+)");
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    std::smatch match;
+    const long pid = temporaryOwner(it->path().filename().string());
     struct stat info {};
-    if (!std::regex_match(name, match, temporary) || ::lstat(it->path().c_str(), &info) != 0) continue;
-    const long pid = std::stol(match[1].str());
+    if (pid < 0 || ::lstat(it->path().c_str(), &info) != 0) continue;
     if (info.st_uid != ::geteuid() || pid == long(::getpid()) || processRuns(pid)) continue;
     std::error_code ignored;
     fs::remove_all(it->path(), ignored);
