@@ -10,7 +10,6 @@
 #include <iostream>
 
 #include "AtomicFile.h"
-
 #include "Error.h"
 #include "render/Method.h"
 
@@ -128,12 +127,11 @@ std::string defaultCacheDir() {
   return ".cache/misalloc";
 }
 
-std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir) {
-  if (analyticReference(scene)) return std::nullopt;
-  return (fs::path(cacheDir) / "references" / (referenceKey(scene, spp) + ".exr")).string();
-}
-
 namespace {
+
+std::string cacheEntryPath(const std::string& key, const std::string& cacheDir) {
+  return (fs::path(cacheDir) / "references" / (key + ".exr")).string();
+}
 
 // The cache entry's channels: the image, then the standard deviation of its error.
 const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_error.G", "standard_error.B"};
@@ -146,15 +144,16 @@ uint64_t pixelChecksum(const SampledReference& reference) {
 }
 
 // What a cache entry says it is; the checksum is of its pixels as read.
-ExrAttributes cacheClaims(const Scene& scene, int spp, const SampledReference& reference) {
-  return {{"misalloc.reference.key", referenceKey(scene, spp)},
+ExrAttributes cacheClaims(const std::string& key, const Scene& scene, int spp, const SampledReference& reference) {
+  return {{"misalloc.reference.key", key},
           {"misalloc.reference.estimator", referenceEstimator(scene.options)},
           {"misalloc.reference.spp", std::to_string(spp)},
           {"misalloc.reference.size", fmt::format("{}x{}", scene.grid.width, scene.grid.height)},
           {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(reference))}};
 }
 
-std::string encodeCacheEntry(const Scene& scene, int spp, const SampledReference& reference) {
+std::string encodeCacheEntry(const std::string& key, const Scene& scene, int spp,
+                             const SampledReference& reference) {
   std::vector<std::vector<float>> planes(6, std::vector<float>(reference.standardError.size() / 3));
   for (size_t p = 0; p < planes[0].size(); ++p)
     for (int c = 0; c < 3; ++c) {
@@ -164,7 +163,7 @@ std::string encodeCacheEntry(const Scene& scene, int spp, const SampledReference
   std::vector<std::string> names{"R", "G", "B"};
   names.insert(names.end(), kErrorChannels.begin(), kErrorChannels.end());
   return encodeExrChannels(reference.image.width, reference.image.height, names, planes,
-                           cacheClaims(scene, spp, reference));
+                           cacheClaims(key, scene, spp, reference));
 }
 
 // The cached reference, or why it cannot be trusted.
@@ -173,7 +172,7 @@ struct CacheEntry {
   std::string problem;
 };
 
-CacheEntry readCacheEntry(const std::string& path, const Scene& scene, int spp) {
+CacheEntry readCacheEntry(const std::string& path, const std::string& key, const Scene& scene, int spp) {
   ExrAttributes found;
   SampledReference entry;
   try {
@@ -187,7 +186,7 @@ CacheEntry readCacheEntry(const std::string& path, const Scene& scene, int spp) 
   } catch (const InputError& e) {
     return {std::nullopt, e.what()};
   }
-  for (const auto& [name, expected] : cacheClaims(scene, spp, entry)) {
+  for (const auto& [name, expected] : cacheClaims(key, scene, spp, entry)) {
     auto it = found.find(name);
     if (it == found.end()) return {std::nullopt, fmt::format("it has no {}", name)};
     if (it->second != expected)
@@ -202,14 +201,20 @@ void reportProgress(int done, int spp) {
 
 }  // namespace
 
+std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const std::string& cacheDir) {
+  if (analyticReference(scene)) return std::nullopt;
+  return cacheEntryPath(referenceKey(scene, spp), cacheDir);
+}
+
 Reference findReference(const Scene& scene, int spp, const std::string& cacheDir, const SamplerFactory& makeSampler) {
   if (auto analytic = analyticReference(scene)) return Reference{*analytic, {}, "analytic ([HS14] eq. 6.17)", ""};
-  const std::string path = *referenceCachePath(scene, spp, cacheDir);
+  // The key hashes every texel: computed once for the path and the claims.
+  const std::string key = referenceKey(scene, spp), path = cacheEntryPath(key, cacheDir);
   const std::string source = fmt::format("{}, {} spp", referenceEstimator(scene.options), spp);
   std::string recomputed;
   std::error_code ec;
   if (fs::exists(path, ec)) {
-    CacheEntry entry = readCacheEntry(path, scene, spp);
+    CacheEntry entry = readCacheEntry(path, key, scene, spp);
     if (entry.reference)
       return Reference{std::move(entry.reference->image), std::move(entry.reference->standardError),
                        source + " (cached)", path};
@@ -227,7 +232,7 @@ Reference findReference(const Scene& scene, int spp, const std::string& cacheDir
   const Scene sampledScene = referenceScene(scene);
   std::unique_ptr<StageSampler> sampler = makeSampler(sampledScene);
   SampledReference sampled = sampleReference(*sampler, sampledScene, spp, kReferenceSeed, reportProgress);
-  writeFileAtomically(path, encodeCacheEntry(scene, spp, sampled));
+  writeFileAtomically(path, encodeCacheEntry(key, scene, spp, sampled));
   return Reference{std::move(sampled.image), std::move(sampled.standardError), source + recomputed, path};
 }
 

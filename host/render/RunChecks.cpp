@@ -5,7 +5,6 @@
 #include <algorithm>
 
 #include "Error.h"
-#include "sampling/Costs.h"
 
 namespace misalloc {
 namespace {
