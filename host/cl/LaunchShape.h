@@ -26,7 +26,7 @@ struct DeviceLimits {
 DeviceLimits deviceLimits(const cl::Device& device);
 
 // The local memory of sampleStage at this work-group size: its sums, running sums
-// (`statSlots`, StageSampler::statSlots()) and pass counts, in double where
+// (`statSlots`, StageStatistics::statSlots()) and pass counts, in double where
 // `doubleSums` (ma_acc, kernels/common.h) else float. With no running sums the kernel
 // declares a one-row placeholder that it never touches: PoCL and clang's nvptx64
 // back end both drop it, so it is not counted.
