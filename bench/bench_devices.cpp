@@ -17,7 +17,7 @@
 
 #include "cl/Device.h"
 #include "render/Render.h"
-#include "sampling/Costs.h"
+#include "sampling/CostModel.h"
 #include "sampling/SamplerChoice.h"
 #include "scene/Scene.h"
 
@@ -75,8 +75,9 @@ int main(int argc, char** argv) {
   AdaptiveOptions adaptive;
   {
     SamplerDevices cpu("cpu");
+    // One set of costs for every device list, so that they allocate alike.
     auto plain = cpu.makeSampler(scene, SamplerConfig{}, 8);
-    adaptive.costs = measureCosts(*plain);
+    adaptive.costs = plain->costModel().perSample(false);
   }
   std::cout << fmt::format("{} x seed000, {}x{}, {} spp, {} interleaved repeats; costs {:.3g}, {:.3g} s/sample\n\n",
                            envmap, size, size, spp, repeats, adaptive.costs[0], adaptive.costs[1]);

@@ -110,7 +110,7 @@ TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out"
   CHECK(md.find("| exact | – |") != std::string::npos);
   CHECK(md.find("## RMSE×1000 at 10 spp") != std::string::npos);
   CHECK(summaryCsv(s) == fmt::format("method,a\nequal,10.0000\nheuristic,{:.4f}\nexact,\n", h->budgets[0].rmseX1000));
-  std::string svg = errorTimePlotSvg(a);
+  std::string svg = errorTimePlotSvg(SceneGroup{a.info.label, {}, {&a}});
   CHECK(svg.rfind("<svg", 0) == 0);
   CHECK(svg.find("</svg>") != std::string::npos);
   CHECK(std::count(svg.begin(), svg.end(), '\n') > 3);
@@ -122,6 +122,7 @@ TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out"
 TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][compare]") {
   TempDir dir("compare");
   const fs::path out = dir.path / "out";
+  // By default each scene runs with the plain and the optimal pdf.
   auto r =
       runMisalloc(fmt::format("compare --envmap cosk:2 --size 8x8 --budgets 10,20 --repeats 2 "
                               "--methods equal,heuristic,exact,brdf --device cpu --out-dir {} --cache-dir {}",
@@ -130,14 +131,31 @@ TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][comp
   REQUIRE(r.exitCode == 0);
   for (const char* file : {"index.html", "summary.md", "summary.csv", "summary.json", "budgets.csv", "runs.json",
                            "runs.csv", "plot_cosk_2.svg", "cosk_2/reference.png", "cosk_2/exact_20spp.exr",
-                           "cosk_2/exact_20spp.png", "cosk_2/exact_20spp_alpha.exr", "cosk_2/exact_20spp_alpha.png"})
+                           "cosk_2/exact_20spp.png", "cosk_2/exact_20spp_alpha.exr", "cosk_2/exact_20spp_alpha.png",
+                           "cosk_2-optimal/exact_20spp.exr", "cosk_2-optimal/reference.png"})
     CHECK(fs::exists(out / file));
+  // One plot per scene, with every method and pdf: equal/plain and exact/optimal meet.
+  CHECK_FALSE(fs::exists(out / "plot_cosk_2-optimal.svg"));
+  std::ifstream plot(out / "plot_cosk_2.svg");
+  const std::string svg((std::istreambuf_iterator<char>(plot)), std::istreambuf_iterator<char>());
+  for (const char* line : {"equal / plain", "exact / optimal", "brdf / optimal"})
+    CHECK(svg.find(line) != std::string::npos);
+  size_t lines = 0;
+  for (size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++lines;
+  CHECK(lines == 4 * 2);
   nlohmann::json runs = nlohmann::json::parse(std::ifstream(out / "runs.json"));
   CHECK(runs["interrupted"] == false);
-  CHECK(runs["runs"].size() == 4 * 2 * 2);
+  CHECK(runs["runs"].size() == 4 * 2 * 2 * 2);
+  // The adaptive renders' stages carry the cost model's prediction; the fixed splits' do not.
+  for (const auto& run : runs["runs"]) {
+    REQUIRE(!run["stages"].empty());
+    const bool adaptive = run["method"] == "heuristic" || run["method"] == "exact";
+    CHECK(run["stages"][0].contains("predicted_kernel_s") == adaptive);
+  }
   CHECK(runs["cases"][0]["reference"] == "analytic ([HS14] eq. 6.17)");
   nlohmann::json summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
   CHECK(summary["table_spp"] == 20);
+  CHECK(summary["cost_model"]["stages"] == 2 * 2 * 2 * 2 * 2);  // heuristic and exact: pilot and a stage each
   for (const auto& m : summary["cases"][0]["methods"]) {
     CHECK(m["budgets"].size() == 2);
     CHECK(m["equal_time_rmse_x1000"].size() == 2);
@@ -149,7 +167,7 @@ TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][comp
   int images = 0;
   for (auto it = std::sregex_iterator(html.begin(), html.end(), src); it != std::sregex_iterator(); ++it, ++images)
     CHECK(fs::exists(out / (*it)[1].str()));
-  CHECK(images == 1 + 1 + 4 * 2 + 2);  // plot, reference, each method × budget, two α maps
+  CHECK(images == 1 + 2 * (1 + 4 * 2 + 2));  // plot; per pdf: reference, each method × budget, two α maps
 }
 
 TEST_CASE("compare rejects bad options before it writes anything", "[cli][compare][bad-input]") {

@@ -45,9 +45,8 @@ KeptGridSearch& keptSearch(StageStatistics& stages) {
 
 }  // namespace
 
-GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, std::vector<double> costs, GridRule rule,
-                                         std::optional<PooledSelection> pooling)
-    : costs_(std::move(costs)), rule_(rule), pooling_(pooling) {
+GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, GridRule rule, std::optional<PooledSelection> pooling)
+    : rule_(rule), pooling_(pooling) {
   const SamplerConfig& config = stages.config();
   if (config.gridSize <= 0 || config.sampleCapacity <= 0)
     throw std::logic_error("grid search on a sampler that does not keep what it needs");
@@ -55,8 +54,8 @@ GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, std::vector<do
   bytesPerPixel_ = gridSearchBytesPerPixel(stages.scene().techniqueCount(), config.gridSize, config.runningSums);
 }
 
-StageAllocation GridSearchAllocator::allocate(StageStatistics& stages) {
-  GridSearchResult search = keptSearch(stages).run(stages.takeStoredSamples(), costs_, rule_, pooling_);
+StageAllocation GridSearchAllocator::allocate(StageStatistics& stages, const std::vector<double>& costs) {
+  GridSearchResult search = keptSearch(stages).run(stages.takeStoredSamples(), costs, rule_, pooling_);
   return {std::move(search.allocations), std::move(search.varianceRatio), std::move(search.skipped)};
 }
 

@@ -20,16 +20,14 @@ class GridSearchAllocator final : public StageAllocator {
   // rule (b) over neighbourhoods, with the skip rule. Throws std::logic_error for a
   // sampler that keeps no grid, DeviceError where the grid's buffers do not fit the
   // device.
-  GridSearchAllocator(StageStatistics& stages, std::vector<double> costs, GridRule rule,
-                      std::optional<PooledSelection> pooling);
+  GridSearchAllocator(StageStatistics& stages, GridRule rule, std::optional<PooledSelection> pooling);
 
   // Adds the samples stored since the last search to the search's sums and selects
   // by all of them.
-  StageAllocation allocate(StageStatistics& stages) override;
+  StageAllocation allocate(StageStatistics& stages, const std::vector<double>& costs) override;
   std::size_t bytesPerPixel() const override { return bytesPerPixel_; }
 
  private:
-  std::vector<double> costs_;
   GridRule rule_;
   std::optional<PooledSelection> pooling_;
   std::size_t bytesPerPixel_;

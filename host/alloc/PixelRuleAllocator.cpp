@@ -24,11 +24,10 @@ Allocation allocatePixel(PixelRule rule, const PixelStats& stats, const PixelSam
   throw std::logic_error("unknown per-pixel rule");
 }
 
-PixelRuleAllocator::PixelRuleAllocator(PixelRule rule, std::vector<double> costs, int poolRadius,
-                                       ZeroWeightRule linearRule)
-    : rule_(rule), costs_(std::move(costs)), poolRadius_(poolRadius), linearRule_(linearRule) {}
+PixelRuleAllocator::PixelRuleAllocator(PixelRule rule, int poolRadius, ZeroWeightRule linearRule)
+    : rule_(rule), poolRadius_(poolRadius), linearRule_(linearRule) {}
 
-StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages) {
+StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages, const std::vector<double>& costs) {
   const Scene& scene = stages.scene();
   const SamplerConfig& config = stages.config();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = stages.statSlots();
@@ -43,7 +42,7 @@ StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages) {
     PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, config.statsMask, M);
     std::optional<PixelSamples> samples;
     if (!stored.empty()) samples = decodePixelSamples(stored, p, taken, config.sampleCapacity, M);
-    out.allocations[p] = allocatePixel(rule_, pixelStats, samples ? &*samples : nullptr, costs_, linearRule_);
+    out.allocations[p] = allocatePixel(rule_, pixelStats, samples ? &*samples : nullptr, costs, linearRule_);
   }
   return out;
 }

@@ -23,15 +23,14 @@ Allocation allocatePixel(PixelRule rule, const PixelStats& stats, const PixelSam
 class PixelRuleAllocator final : public StageAllocator {
  public:
   // `poolRadius`: the sums pooled over (2r + 1)² pixels.
-  PixelRuleAllocator(PixelRule rule, std::vector<double> costs, int poolRadius, ZeroWeightRule linearRule);
+  PixelRuleAllocator(PixelRule rule, int poolRadius, ZeroWeightRule linearRule);
 
   // Every pixel's α from its pooled running sums (and for the linear rule its samples);
   // varianceRatio 1 and skipped 0 everywhere: the rules predict no gain.
-  StageAllocation allocate(StageStatistics& stages) override;
+  StageAllocation allocate(StageStatistics& stages, const std::vector<double>& costs) override;
 
  private:
   PixelRule rule_;
-  std::vector<double> costs_;
   int poolRadius_;
   ZeroWeightRule linearRule_;
 };

@@ -26,8 +26,9 @@ class StageAllocator {
   virtual ~StageAllocator() = default;
 
   // Every pixel's α for the next stage, from what the stages of a sampler since its
-  // reset() left in `stages`: its running sums, its stored samples.
-  virtual StageAllocation allocate(StageStatistics& stages) = 0;
+  // reset() left in `stages`: its running sums, its stored samples. `costs`: c_k per
+  // sample of the kernel that runs that stage (sampling/CostModel.h).
+  virtual StageAllocation allocate(StageStatistics& stages, const std::vector<double>& costs) = 0;
   // What the allocation keeps per pixel beside the sampler's running sums and stored
   // samples, for the report.
   virtual std::size_t bytesPerPixel() const { return 0; }

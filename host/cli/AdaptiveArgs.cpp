@@ -6,7 +6,7 @@
 
 #include "Error.h"
 #include "OptionRange.h"
-#include "sampling/Costs.h"
+#include "sampling/CostModel.h"
 
 namespace misalloc {
 namespace {

@@ -37,7 +37,7 @@ struct CompareArgs {
   AdaptiveArgs adaptive;
   DeviceArgs devices;
   CompareOptions compare;
-  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain";
+  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal";
   bool suite = false;
 };
 
@@ -81,7 +81,9 @@ int runCompare(CompareArgs& args) {
     }
   } else {
     Scene probe = args.scene.make();  // reads the envmap once, so bad input fails before any work
-    compare.cases.push_back({caseLabel(probe.options), probe.options});
+    compare.cases.push_back({caseLabel(probe.options), probe.options, {}});
+    // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
+    if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
   compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(args.envmapPdfs));
   compare.methods = parseMethodList(args.methods);
@@ -92,6 +94,8 @@ int runCompare(CompareArgs& args) {
   if (args.command->count("--reference-spp") == 0)
     compare.referenceSpp = std::max(compare.referenceSpp, 64 * compare.budgets.back());
   compare.adaptive = args.adaptive.make(compare.cases.front().scene.techniqueCount());
+  if (args.command->count("--envmap-pdfs") == 0)
+    leaveOutBiasedMethods(compare.cases, compare.methods, compare.budgets, compare.adaptive);
   compare.device = args.devices.spec();
   validateCompareOptions(compare);
   for (const CompareCase& c : compare.cases)
@@ -137,7 +141,8 @@ Subcommand addCompareCommand(CLI::App& app) {
   command->add_option("--budgets", args->budgets, "samples per pixel, ascending")->capture_default_str();
   command
       ->add_option("--envmap-pdfs", args->envmapPdfs,
-                   "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal")
+                   "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal (default: plain and "
+                   "optimal side by side; plain alone with --split-brdf)")
       ->capture_default_str();
   command->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
       ->capture_default_str()

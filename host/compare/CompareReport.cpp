@@ -13,8 +13,8 @@ void writeCompareReport(const Summary& summary, const std::string& outDir) {
   writeFileAtomically(outDir + "/summary.csv", summaryCsv(summary));
   writeFileAtomically(outDir + "/summary.json", jsonText(summaryJson(summary)));
   writeFileAtomically(outDir + "/budgets.csv", budgetsCsv(summary));
-  for (const CaseSummary& c : summary.cases)
-    writeFileAtomically(outDir + "/" + plotFileName(c.info.label), errorTimePlotSvg(c));
+  for (const SceneGroup& scene : groupByScene(summary))
+    writeFileAtomically(outDir + "/" + plotFileName(scene.label), errorTimePlotSvg(scene));
   writeFileAtomically(outDir + "/index.html", indexHtml(summary));
 }
 

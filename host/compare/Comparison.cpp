@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -49,6 +50,7 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.flooredFraction = s.flooredFraction;
   rec.skippedFraction = s.skippedFraction;
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
+  rec.stages = r.stages;
   return rec;
 }
 
@@ -69,7 +71,14 @@ nlohmann::json runJson(const RunRecord& r) {
           {"fallback_pixel_fraction", r.fallbackFraction},
           {"floored_pixel_fraction", r.flooredFraction},
           {"skipped_pixel_fraction", r.skippedFraction},
-          {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel}};
+          {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
+          {"stages", stagesJson(r.stages)}};
+}
+
+nlohmann::json leftOutJson(const std::vector<LeftOutMethod>& leftOut) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const LeftOutMethod& l : leftOut) list.push_back({{"method", methodName(l.method)}, {"why", l.why}});
+  return list;
 }
 
 nlohmann::json caseJson(const CaseInfo& c) {
@@ -80,7 +89,8 @@ nlohmann::json caseJson(const CaseInfo& c) {
           {"costs_source", c.costSource},
           {"reference", c.referenceSource},
           {"reference_variance", c.referenceVariance},
-          {"device", c.device}};
+          {"device", c.device},
+          {"left_out", leftOutJson(c.leftOut)}};
 }
 
 std::string runsCsv(const Comparison& comparison) {
@@ -118,6 +128,14 @@ std::string alphaMapPath(const std::string& caseLabel, Method method, int budget
   return runStem(caseLabel, method, budget) + "_alpha.exr";
 }
 
+std::vector<Method> caseMethods(const CompareCase& c, const std::vector<Method>& methods) {
+  std::vector<Method> out;
+  for (Method m : methods)
+    if (std::none_of(c.leftOut.begin(), c.leftOut.end(), [&](const LeftOutMethod& l) { return l.method == m; }))
+      out.push_back(m);
+  return out;
+}
+
 void validateCompareOptions(const CompareOptions& options) {
   if (options.cases.empty()) throw InputError("compare: no scene");
   if (options.methods.empty()) throw InputError("--methods: no method");
@@ -130,17 +148,20 @@ void validateCompareOptions(const CompareOptions& options) {
   }
   if (options.repeats < 1) throw InputError(fmt::format("--repeats {}: need at least 1", options.repeats));
   for (const CompareCase& c : options.cases)
-    for (Method m : options.methods)
+    for (Method m : caseMethods(c, options.methods))
       for (int budget : options.budgets) requireValidRun(c.scene, m, Estimator::MultiSample, budget, options.adaptive);
 }
 
 Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard) {
   fs::create_directories(options.outDir);
-  const int perCase = int(options.methods.size() * options.budgets.size()) * options.repeats;
-  ProgressMeter meter(int(options.cases.size()) * perCase);
+  int runs = 0;
+  for (const CompareCase& c : options.cases)
+    runs += int(caseMethods(c, options.methods).size() * options.budgets.size()) * options.repeats;
+  ProgressMeter meter(runs);
   SamplerDevices devices(options.device);
   Comparison out;
   for (const CompareCase& c : options.cases) {
+    const std::vector<Method> methods = caseMethods(c, options.methods);
     Scene scene = makeScene(c.scene);
     fs::create_directories(fs::path(options.outDir) / c.label);
     // The reference and the costs with the plain envmap pdf ([Kar19]: withPlainEnvmapPdf).
@@ -156,7 +177,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     double referenceVariance = 0;
     for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name()});
+                         reference->source, referenceVariance, devices.name(), c.leftOut});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
@@ -166,12 +187,12 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     for (int budget : options.budgets) {
       // Built (and their kernels compiled) once per budget; each render starts afresh.
       std::vector<std::unique_ptr<StageSampler>> samplers;
-      for (Method method : options.methods)
+      for (Method method : methods)
         samplers.push_back(devices.makeSampler(
             scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize));
       for (int r = 0; r < options.repeats; ++r)
-        for (size_t m = 0; m < options.methods.size(); ++m) {
-          const Method method = options.methods[m];
+        for (size_t m = 0; m < methods.size(); ++m) {
+          const Method method = methods[m];
           if (guard.requested()) {
             out.interrupted = true;
             writeRuns(options.outDir, out);

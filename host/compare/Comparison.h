@@ -11,11 +11,21 @@
 
 namespace misalloc {
 
+// A method a case does not run, and why.
+struct LeftOutMethod {
+  Method method;
+  std::string why;
+};
+
 // One scene of a comparison, with the label that names its column and its folder.
 struct CompareCase {
   std::string label;
   SceneOptions scene;
+  std::vector<LeftOutMethod> leftOut;  // the default pdfs: methods biased with this case's pdf
 };
+
+// The methods of `methods` that `c` runs, in that order.
+std::vector<Method> caseMethods(const CompareCase& c, const std::vector<Method>& methods);
 
 struct CompareOptions {
   std::vector<CompareCase> cases;
@@ -24,7 +34,7 @@ struct CompareOptions {
   int repeats = 4;           // independent seeds per (method, budget)
   uint64_t seed = 1;         // repeat r uses seed + r
   int tableBudget = 200;     // the spp of the Table 5.2 layout (the nearest budget)
-  AdaptiveOptions adaptive;  // costs empty: measured per case
+  AdaptiveOptions adaptive;  // costs empty: each sampler's own (sampling/CostModel.h)
   std::string device = "auto";
   int localSize = 0;  // 0: each device's own (cl/LaunchShape.h)
   int referenceSpp = 16384;
@@ -49,6 +59,7 @@ struct RunRecord {
   double flooredFraction = 0;     // pixels whose counts were raised to one per technique
   double skippedFraction = 0;     // pixels the skip rule kept at equal weights
   double statisticsBytesPerPixel = 0;
+  std::vector<StageTiming> stages;  // kernel times, predicted and measured
 
   // 1/(MSE × time): what a method buys per second.
   double efficiency() const { return 1.0 / (mse * wallSeconds); }
@@ -60,10 +71,11 @@ struct CaseInfo {
   nlohmann::json scene;
   std::vector<std::string> techniques;
   std::vector<double> costs;
-  std::string costSource;  // "measured" or "--cost"
+  std::string costSource;  // "calibrated" (each sampler's CostModel) or "--cost"
   std::string referenceSource;
   double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;
+  std::vector<LeftOutMethod> leftOut;
 };
 
 struct Comparison {

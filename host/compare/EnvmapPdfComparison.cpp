@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <map>
 #include <sstream>
 
 #include "Error.h"
 #include "compare/Suite.h"
+#include "render/RunChecks.h"
 
 namespace misalloc {
 namespace {
@@ -19,24 +21,6 @@ std::string sceneWithoutPdf(const CaseInfo& info) {
   return scene.dump();
 }
 
-std::string requestedPdf(const CaseInfo& info) { return info.scene["envmap_pdf"]["requested"]; }
-
-// Cases grouped by scene, in first-seen order; each group maps a pdf's name to its case.
-struct SceneGroup {
-  std::string label;  // the first case's
-  std::map<std::string, const CaseSummary*> byPdf;
-};
-
-std::vector<SceneGroup> groupByScene(const Summary& s) {
-  std::vector<SceneGroup> groups;
-  std::map<std::string, size_t> index;
-  for (const CaseSummary& c : s.cases) {
-    auto [it, inserted] = index.emplace(sceneWithoutPdf(c.info), groups.size());
-    if (inserted) groups.push_back({c.info.label, {}});
-    groups[it->second].byPdf[requestedPdf(c.info)] = &c;
-  }
-  return groups;
-}
 
 // Every pdf run, in the order of the first scene that ran it.
 std::vector<std::string> pdfNames(const Summary& s) {
@@ -55,6 +39,39 @@ bool usable(const MethodSummary* m) {
 }
 
 }  // namespace
+
+std::string requestedPdf(const CaseInfo& info) { return info.scene["envmap_pdf"]["requested"]; }
+
+std::vector<SceneGroup> groupByScene(const Summary& s) {
+  std::vector<SceneGroup> groups;
+  std::map<std::string, size_t> index;
+  for (const CaseSummary& c : s.cases) {
+    auto [it, inserted] = index.emplace(sceneWithoutPdf(c.info), groups.size());
+    if (inserted) groups.push_back({c.info.label, {}, {}});
+    groups[it->second].byPdf[requestedPdf(c.info)] = &c;
+    groups[it->second].cases.push_back(&c);
+  }
+  return groups;
+}
+
+void leaveOutBiasedMethods(std::vector<CompareCase>& cases, const std::vector<Method>& methods,
+                           const std::vector<int>& budgets, const AdaptiveOptions& adaptive) {
+  auto refusal = [&](const SceneOptions& scene, Method m) -> std::optional<std::string> {
+    try {
+      for (int budget : budgets) requireValidRun(scene, m, Estimator::MultiSample, budget, adaptive);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::nullopt;
+  };
+  for (CompareCase& c : cases) {
+    if (c.scene.envmapPdf.plain()) continue;
+    SceneOptions plain = c.scene;
+    plain.envmapPdf = EnvmapPdf{};
+    for (Method m : methods)
+      if (auto why = refusal(c.scene, m); why && !refusal(plain, m)) c.leftOut.push_back({m, *why});
+  }
+}
 
 std::vector<EnvmapPdf> parseEnvmapPdfList(const std::string& list) {
   std::vector<EnvmapPdf> pdfs;

@@ -10,8 +10,8 @@
 namespace misalloc {
 namespace {
 
-constexpr double kWidth = 720, kHeight = 480;
-constexpr double kLeft = 70, kRight = 170, kTop = 40, kBottom = 55;  // margins; the legend sits right
+constexpr double kWidth = 800, kHeight = 480;
+constexpr double kLeft = 70, kRight = 250, kTop = 40, kBottom = 55;  // margins; the legend sits right
 
 // A colour per method that stays the same across plots.
 const char* methodColour(Method m) {
@@ -56,6 +56,12 @@ struct LogAxis {
   }
 };
 
+// A dash pattern per pdf, in the order the scene ran them: solid for the first.
+const char* pdfDash(size_t index) {
+  static const char* const dashes[] = {"", "7,4", "2,3", "9,3,2,3"};
+  return dashes[index % (sizeof(dashes) / sizeof(dashes[0]))];
+}
+
 std::string tickLabel(double value) { return fmt::format("{:g}", value); }
 
 std::string axes(const LogAxis& x, const LogAxis& y) {
@@ -82,50 +88,65 @@ std::string axes(const LogAxis& x, const LogAxis& y) {
   return svg;
 }
 
+// One method's line through its budgets, its error bars and its legend entry in `row`.
+std::string methodLine(const MethodSummary& m, const std::string& name, const char* colour, const char* dash,
+                       const LogAxis& x, const LogAxis& y, double legendY) {
+  std::string svg, points;
+  for (const BudgetStats& b : m.budgets) {
+    double px = x(b.wallSeconds), py = y(b.rmseX1000);
+    points += fmt::format("{:.1f},{:.1f} ", px, py);
+    double lo = std::max(b.rmseX1000 - b.rmseSpreadX1000, 0.5 * b.rmseX1000);
+    svg += fmt::format(R"(<line x1="{0:.1f}" y1="{1:.1f}" x2="{0:.1f}" y2="{2:.1f}" stroke="{3}"/>)", px, y(lo),
+                       y(b.rmseX1000 + b.rmseSpreadX1000), colour);
+    svg += fmt::format(
+        R"(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"><title>{} {} spp: {:.2f} at {:.3g} s</title></circle>)", px,
+        py, colour, name, b.budget, b.rmseX1000, b.wallSeconds);
+  }
+  svg += fmt::format(R"(<polyline points="{}" fill="none" stroke="{}" stroke-width="1.5" stroke-dasharray="{}"/>)",
+                     points, colour, dash) +
+         "\n";
+  const double ly = legendY;
+  svg += fmt::format(R"(<line x1="{0}" y1="{1}" x2="{2}" y2="{1}" stroke="{3}" stroke-width="2" stroke-dasharray="{4}"/>)",
+                     kWidth - kRight + 12, ly, kWidth - kRight + 36, colour, dash);
+  svg += fmt::format(R"(<text x="{}" y="{}" font-size="12">{}</text>)", kWidth - kRight + 42, ly + 4, name) + "\n";
+  return svg;
+}
+
 }  // namespace
 
-std::string errorTimePlotSvg(const CaseSummary& scene) {
+std::string errorTimePlotSvg(const SceneGroup& scene) {
   double tMin = std::numeric_limits<double>::infinity(), tMax = 0, eMin = tMin, eMax = 0;
-  for (const MethodSummary& m : scene.methods)
-    for (const BudgetStats& b : m.budgets) {
-      if (!(b.wallSeconds > 0 && b.rmseX1000 > 0)) continue;
-      tMin = std::min(tMin, b.wallSeconds), tMax = std::max(tMax, b.wallSeconds);
-      eMin = std::min(eMin, std::max(b.rmseX1000 - b.rmseSpreadX1000, 0.5 * b.rmseX1000));
-      eMax = std::max(eMax, b.rmseX1000 + b.rmseSpreadX1000);
-    }
+  for (const CaseSummary* c : scene.cases)
+    for (const MethodSummary& m : c->methods)
+      for (const BudgetStats& b : m.budgets) {
+        if (!(b.wallSeconds > 0 && b.rmseX1000 > 0)) continue;
+        tMin = std::min(tMin, b.wallSeconds), tMax = std::max(tMax, b.wallSeconds);
+        eMin = std::min(eMin, std::max(b.rmseX1000 - b.rmseSpreadX1000, 0.5 * b.rmseX1000));
+        eMax = std::max(eMax, b.rmseX1000 + b.rmseSpreadX1000);
+      }
   std::string svg = fmt::format(
       R"(<svg xmlns="http://www.w3.org/2000/svg" width="{0}" height="{1}" viewBox="0 0 {0} {1}" font-family="sans-serif">)"
       "\n<rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>\n",
       kWidth, kHeight);
   svg += fmt::format(R"(<text x="{}" y="24" text-anchor="middle" font-size="15">{}: error against time</text>)",
-                     (kLeft + kWidth - kRight) / 2, scene.info.label) +
+                     (kLeft + kWidth - kRight) / 2, scene.label) +
          "\n";
   if (tMax == 0) return svg + "<text x=\"100\" y=\"100\">no finished runs</text>\n</svg>\n";
   LogAxis x(tMin, tMax, kLeft, kWidth - kRight), y(eMin, eMax, kHeight - kBottom, kTop);
   svg += axes(x, y) + "\n";
-  int row = 0;
-  for (const MethodSummary& m : scene.methods) {
-    if (m.budgets.empty()) continue;
-    const char* colour = methodColour(m.method);
-    std::string points;
-    for (const BudgetStats& b : m.budgets) {
-      double px = x(b.wallSeconds), py = y(b.rmseX1000);
-      points += fmt::format("{:.1f},{:.1f} ", px, py);
-      double lo = std::max(b.rmseX1000 - b.rmseSpreadX1000, 0.5 * b.rmseX1000);
-      svg += fmt::format(R"(<line x1="{0:.1f}" y1="{1:.1f}" x2="{0:.1f}" y2="{2:.1f}" stroke="{3}"/>)", px, y(lo),
-                         y(b.rmseX1000 + b.rmseSpreadX1000), colour);
-      svg += fmt::format(
-          R"(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"><title>{} {} spp: {:.2f} at {:.3g} s</title></circle>)",
-          px, py, colour, methodName(m.method), b.budget, b.rmseX1000, b.wallSeconds);
+  int lines = 0, row = 0;
+  for (const CaseSummary* c : scene.cases)
+    for (const MethodSummary& m : c->methods) lines += m.budgets.empty() ? 0 : 1;
+  // Legend rows 20 px apart, closer where many lines share the plot's height.
+  const double spacing = std::min(20.0, (kHeight - kTop - kBottom - 10) / std::max(1, lines));
+  for (size_t pdf = 0; pdf < scene.cases.size(); ++pdf)
+    for (const MethodSummary& m : scene.cases[pdf]->methods) {
+      if (m.budgets.empty()) continue;
+      const std::string name = scene.cases.size() > 1
+                                   ? methodName(m.method) + " / " + requestedPdf(scene.cases[pdf]->info)
+                                   : methodName(m.method);
+      svg += methodLine(m, name, methodColour(m.method), pdfDash(pdf), x, y, kTop + 10 + spacing * row++);
     }
-    svg += fmt::format(R"(<polyline points="{}" fill="none" stroke="{}" stroke-width="1.5"/>)", points, colour) + "\n";
-    double ly = kTop + 10 + 20 * row++;
-    svg += fmt::format(R"(<line x1="{0}" y1="{1}" x2="{2}" y2="{1}" stroke="{3}" stroke-width="2"/>)",
-                       kWidth - kRight + 12, ly, kWidth - kRight + 36, colour);
-    svg += fmt::format(R"(<text x="{}" y="{}" font-size="12">{}</text>)", kWidth - kRight + 42, ly + 4,
-                       methodName(m.method)) +
-           "\n";
-  }
   return svg + "</svg>\n";
 }
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "compare/EnvmapPdfComparison.h"
 #include "compare/SummaryTables.h"
 #include "report/PreviewPng.h"
 
@@ -49,7 +50,7 @@ std::string imageGrid(const Summary& s, const CaseSummary& c) {
 
 }  // namespace
 
-std::string plotFileName(const std::string& caseLabel) { return "plot_" + caseLabel + ".svg"; }
+std::string plotFileName(const std::string& sceneLabel) { return "plot_" + sceneLabel + ".svg"; }
 
 std::string indexHtml(const Summary& s) {
   std::string out =
@@ -69,17 +70,27 @@ std::string indexHtml(const Summary& s) {
     out += fmt::format("<h2>Speed-up over equal at equal error, {} spp</h2>\n", budget) + html(speedUpTable(s, budget));
   out += fmt::format("<h2>Seconds per render at {} spp: wall (kernel + allocation)</h2>\n", s.tableBudget) +
          html(timeTable(s));
-  for (const CaseSummary& c : s.cases) {
-    out += fmt::format("<h2 id=\"{0}\">{0}</h2>\n", c.info.label);
-    out += fmt::format("<p class=\"note\">Costs per sample (s): {:.3g}. Reference: {}.</p>\n",
-                       fmt::join(c.info.costs, ", "), c.info.referenceSource);
-    out += fmt::format("<img src=\"{}\" alt=\"error against time\">\n", plotFileName(c.info.label));
-    out +=
-        "<h3>Equal-time RMSE×1000</h3>\n<p class=\"note\">At equal's median render times; ~: continued past the "
-        "measured times with MSE ∝ 1/t.</p>\n" +
-        html(equalTimeTable(c));
-    out += "<h3>Images (repeat 0)</h3>\n<p>Reference: " + image(c.info.label + "/reference.png", "reference") +
-           "</p>\n" + imageGrid(s, c);
+  for (const SceneGroup& scene : groupByScene(s)) {
+    const CaseInfo& first = scene.cases.front()->info;
+    out += fmt::format("<h2 id=\"{0}\">{0}</h2>\n", scene.label);
+    out += fmt::format("<p class=\"note\">Costs per sample: {}. Reference: {}.</p>\n",
+                       first.costs.empty() ? "calibrated on each render's own kernels (runs.json: stages)"
+                                           : fmt::format("{:.3g} s (--cost)", fmt::join(first.costs, ", ")),
+                       first.referenceSource);
+    out += fmt::format("<img src=\"{}\" alt=\"error against time, every method and pdf\">\n",
+                       plotFileName(scene.label));
+    for (const CaseSummary* c : scene.cases) {
+      if (scene.cases.size() > 1) out += fmt::format("<h3 id=\"{0}\">{0}</h3>\n", c->info.label);
+      for (const LeftOutMethod& l : c->info.leftOut)
+        out += fmt::format("<p class=\"note\">Not run: {}, biased with this pdf ({}).</p>\n", methodName(l.method),
+                           escapeHtml(l.why));
+      out +=
+          "<h4>Equal-time RMSE×1000</h4>\n<p class=\"note\">At equal's median render times; ~: continued past the "
+          "measured times with MSE ∝ 1/t.</p>\n" +
+          html(equalTimeTable(*c));
+      out += "<h4>Images (repeat 0)</h4>\n<p>Reference: " + image(c->info.label + "/reference.png", "reference") +
+             "</p>\n" + imageGrid(s, *c);
+    }
   }
   return out + "</body>\n</html>\n";
 }

@@ -109,11 +109,23 @@ const MethodSummary* CaseSummary::find(Method method) const {
   return nullptr;
 }
 
+std::optional<CostModelAccuracy> costModelAccuracy(const std::vector<RunRecord>& runs) {
+  std::vector<double> errors;
+  for (const RunRecord& r : runs)
+    for (const StageTiming& t : r.stages)
+      if (t.predictedKernelSeconds) errors.push_back(std::abs(*t.predictedKernelSeconds / t.kernelSeconds - 1));
+  if (errors.empty()) return std::nullopt;
+  std::sort(errors.begin(), errors.end());
+  const size_t n = errors.size();
+  return CostModelAccuracy{int(n), n % 2 ? errors[n / 2] : (errors[n / 2 - 1] + errors[n / 2]) / 2, errors.back()};
+}
+
 Summary summarize(const Comparison& comparison, const CompareOptions& options) {
   Summary s;
   s.methods = options.methods;
   s.budgets = options.budgets;
   s.interrupted = comparison.interrupted;
+  s.costModel = costModelAccuracy(comparison.runs);
   s.tableBudget = *std::min_element(options.budgets.begin(), options.budgets.end(), [&](int a, int b) {
     return std::abs(a - options.tableBudget) < std::abs(b - options.tableBudget);
   });

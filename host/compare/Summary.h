@@ -41,8 +41,16 @@ struct CaseSummary {
   const MethodSummary* find(Method method) const;
 };
 
+// How well the cost model (sampling/CostModel.h) predicted the kernel time of the
+// adaptive renders' stages: |predicted/measured − 1|, over every such stage.
+struct CostModelAccuracy {
+  int stages = 0;
+  double median = 0, worst = 0;
+};
+
 struct Summary {
   std::vector<CaseSummary> cases;
+  std::optional<CostModelAccuracy> costModel;  // none without an adaptive render
   std::vector<Method> methods;
   std::vector<int> budgets;
   int tableBudget = 0;  // the budget nearest to CompareOptions::tableBudget

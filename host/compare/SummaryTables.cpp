@@ -35,25 +35,6 @@ TextTable methodTable(const Summary& s, bool lowerBetter, Cell cell) {
   return table;
 }
 
-std::string escapeHtml(const std::string& text) {
-  std::string out;
-  for (char ch : text) {
-    switch (ch) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      default:
-        out += ch;
-    }
-  }
-  return out;
-}
 
 constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 
@@ -95,6 +76,26 @@ nlohmann::json budgetJson(const BudgetStats& b) {
 }
 
 }  // namespace
+
+std::string escapeHtml(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    switch (ch) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      default:
+        out += ch;
+    }
+  }
+  return out;
+}
 
 TextTable rmseTable(const Summary& s) {
   return methodTable(s, true, [&](const CaseSummary& c, Method m) { return rmseCell(s, c, m); });
@@ -177,6 +178,10 @@ std::string summaryMarkdown(const Summary& s) {
         "Device: {}. Budgets (spp): {}. Repeats with independent seeds: {}. Times are medians over the repeats.\n\n",
         first->info.device, fmt::join(s.budgets, ", "), repeats);
     for (const CaseSummary& c : s.cases)
+      for (const LeftOutMethod& l : c.info.leftOut)
+        out += fmt::format("Not run in {}: {}, biased with this pdf ({}).\n\n", c.info.label, methodName(l.method),
+                           l.why);
+    for (const CaseSummary& c : s.cases)
       out += fmt::format("Reference of {}: {}; its own variance is {:.2f} % of the smallest error at {} spp (aim: at "
                          "most 2 %), and is taken out of every error below.\n\n",
                          c.info.label, c.info.referenceSource, 100 * referenceShare(c, s.budgets.back()),
@@ -206,6 +211,13 @@ std::string summaryMarkdown(const Summary& s) {
       "\n## Equal-time error per scene\n\nRMSE×1000 of each method interpolated (log–log) at equal's median render "
       "times; `~` marks values continued past the method's measured times with the Monte Carlo law MSE ∝ 1/t.\n";
   for (const CaseSummary& c : s.cases) out += "\n### " + c.info.label + "\n\n" + markdown(equalTimeTable(c));
+  if (s.costModel)
+    out += fmt::format(
+        "\n## Cost model\n\nThe adaptive methods allocate with a model of each stage's kernel time, calibrated on the "
+        "sampler's own launches and refitted after each stage. Over the {} stages of the adaptive renders, its "
+        "prediction made before the stage ran was off by |predicted/measured − 1| = {:.1f} % (median), {:.1f} % at "
+        "worst (runs.json: `stages`).\n",
+        s.costModel->stages, 100 * s.costModel->median, 100 * s.costModel->worst);
   return out;
 }
 
@@ -265,11 +277,13 @@ nlohmann::json summaryJson(const Summary& s) {
   }
   nlohmann::json methods = nlohmann::json::array();
   for (Method m : s.methods) methods.push_back(methodName(m));
-  return {{"interrupted", s.interrupted},
-          {"table_spp", s.tableBudget},
-          {"budgets", s.budgets},
-          {"methods", methods},
-          {"cases", cases}};
+  nlohmann::json costModel;
+  if (s.costModel)
+    costModel = {{"stages", s.costModel->stages},
+                 {"median_abs_relative_error", s.costModel->median},
+                 {"worst_abs_relative_error", s.costModel->worst}};
+  return {{"interrupted", s.interrupted}, {"table_spp", s.tableBudget}, {"budgets", s.budgets},
+          {"methods", methods},         {"cases", cases},              {"cost_model", costModel}};
 }
 
 }  // namespace misalloc

@@ -19,6 +19,8 @@ struct TextTable {
 };
 
 std::string markdown(const TextTable& table);
+// `text` with &, < and > as HTML entities.
+std::string escapeHtml(const std::string& text);
 std::string html(const TextTable& table);
 
 // Rows = methods, columns = scenes ([HS14] Table 5.2): RMSE×1000 at the table budget as

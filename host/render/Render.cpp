@@ -72,6 +72,7 @@ struct Progress {
   int samplesBefore = 0;
   std::vector<unsigned char> fellBack, floored;  // per pixel: a defensive rule was used
   std::vector<unsigned char> skipped;            // per pixel: the skip rule kept equal weights in every stage
+  std::vector<StageTiming> timings;
 
   Progress(int pixels, int M)
       : totals{std::vector<double>(size_t(pixels) * 3, 0.0), std::vector<double>(pixels, 0.0)},
@@ -82,9 +83,11 @@ struct Progress {
 };
 
 // Runs one stage with the given counts; the caller adds it to the estimate.
-// `keepStatistics` false for the last stage, which no allocation reads.
+// `keepStatistics` false for the last stage, which no allocation reads. With a cost
+// model, the stage's kernel time is predicted before it runs, and the model then
+// learns from the time it took.
 TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples,
-                     uint64_t seed, bool keepStatistics) {
+                     uint64_t seed, bool keepStatistics, CostModel* costs) {
   TakenStage stage;
   stage.plan.techniqueCount = sampler.scene().techniqueCount();
   stage.plan.stageSamples = stageSamples;
@@ -92,7 +95,18 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
   stage.plan.keepStatistics = keepStatistics;
   stage.plan.counts = std::move(counts);
   stage.plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
+  StageTiming timing;
+  timing.samples = stageSamples;
+  timing.keptStatistics = keepStatistics;
+  LaunchWork work;
+  if (costs) {
+    work = sampler.launchWork(stage.plan);
+    timing.predictedKernelSeconds = costs->predict(work);
+  }
   stage.result = sampler.run(stage.plan, seed);
+  timing.kernelSeconds = stage.result.kernelSeconds;
+  if (costs) costs->observe(work, stage.result.kernelSeconds);
+  progress.timings.push_back(timing);
   for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += stage.plan.counts[i];
   progress.samplesBefore += stageSamples;
   return stage;
@@ -169,7 +183,7 @@ std::unique_ptr<StageAllocator> makeStageAllocator(StageSampler& sampler, Method
     const Scene& scene = sampler.scene();
     std::optional<PooledSelection> pooling;
     if (pooled) pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
-    return std::make_unique<GridSearchAllocator>(sampler, options.costs, rule, pooling);
+    return std::make_unique<GridSearchAllocator>(sampler, rule, pooling);
   }
   PixelRule rule;
   switch (method) {
@@ -185,7 +199,7 @@ std::unique_ptr<StageAllocator> makeStageAllocator(StageSampler& sampler, Method
     default:
       throw std::logic_error("no allocation for " + methodName(method));
   }
-  return std::make_unique<PixelRuleAllocator>(rule, options.costs, options.poolRadius, options.linearRule);
+  return std::make_unique<PixelRuleAllocator>(rule, options.poolRadius, options.linearRule);
 }
 
 }  // namespace
@@ -197,39 +211,54 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   const Estimator estimator = sampler.config().estimator;
   requireValidRun(scene.options, method, estimator, spp, options);
   std::unique_ptr<StageAllocator> allocator;
+  std::optional<CostModel> givenCosts;
+  CostModel* model = nullptr;
   if (traits.adaptive()) {
-    validateCosts(options.costs, M);
     allocator = makeStageAllocator(sampler, method, options);
+    if (options.costs.empty()) {
+      // The sampler's own, calibrated at its first render before the clock starts, as
+      // its kernels' compilation is, and refitted on every stage it runs since.
+      model = &sampler.costModel();
+    } else {
+      validateCosts(options.costs, M);
+      givenCosts = CostModel::given(options.costs);
+      model = &*givenCosts;
+    }
   }
   auto start = Clock::now();
   sampler.reset();
   Rendering out;
   Progress progress(pixels, M);
   if (!traits.adaptive()) {
-    TakenStage stage = takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false);
+    TakenStage stage =
+        takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false, nullptr);
     accumulateStage(progress.totals, stage, estimator, std::vector<double>(pixels, 1.0));
   } else if (traits.split == Split::Probed) {
     // Evaluation only: a probe of oracleSamples equal-count samples per pixel, with a
     // seed of its own, stands in for the true variance as a function of α; the render
     // then takes the α it finds best in one stage.
     auto probeStart = Clock::now();
-    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples, ~seed, true);
-    std::vector<Allocation> best = allocator->allocate(sampler).allocations;
+    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples, ~seed, true,
+              model);
+    std::vector<Allocation> best = allocator->allocate(sampler, model->perSample(false)).allocations;
     out.allocationSeconds = secondsSince(probeStart);
     Progress render(pixels, M);
     render.samplesBefore = progress.samplesBefore;
-    TakenStage stage = takeStage(sampler, render, stageCounts(render, best, spp), spp, seed, false);
+    render.timings = std::move(progress.timings);
+    TakenStage stage = takeStage(sampler, render, stageCounts(render, best, spp), spp, seed, false, model);
     accumulateStage(render.totals, stage, estimator, std::vector<double>(pixels, 1.0));
     progress = std::move(render);
   } else {
     std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
     out.stageCount = int(sizes.size());
     std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
-    TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true);
+    TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true, model);
     std::vector<double> pilotWeights;
     for (size_t b = 1; b < sizes.size(); ++b) {
+      const bool keepStatistics = b + 1 < sizes.size();
       auto allocationStart = Clock::now();
-      StageAllocation next = allocator->allocate(sampler);
+      // Each technique weighed by its cost in the kernel that runs the next stage.
+      StageAllocation next = allocator->allocate(sampler, model->perSample(keepStatistics));
       for (int p = 0; p < pixels; ++p) progress.skipped[p] &= next.skipped[p];
       std::vector<int32_t> counts = stageCounts(progress, next.allocations, sizes[b]);
       out.allocationSeconds += secondsSince(allocationStart);
@@ -238,7 +267,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
         for (int p = 0; p < pixels; ++p) pilotWeights[p] = pilotWeight(next.varianceRatio[p], sizes[0], spp);
         accumulateStage(progress.totals, pilot, estimator, pilotWeights);
       }
-      TakenStage stage = takeStage(sampler, progress, std::move(counts), sizes[b], seed, b + 1 < sizes.size());
+      TakenStage stage = takeStage(sampler, progress, std::move(counts), sizes[b], seed, keepStatistics, model);
       // The stages after the pilot share the rest of the weight by their sizes.
       std::vector<double> weights(pixels);
       for (int p = 0; p < pixels; ++p) weights[p] = (1 - pilotWeights[p]) * sizes[b] / double(spp - sizes[0]);
@@ -258,6 +287,8 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
                                 double(sampler.storedSampleCount()) * sizeof(float) / pixels +
                                 double(allocator ? allocator->bytesPerPixel() : 0);
   out.kernelSeconds = progress.totals.kernelSeconds;
+  out.stages = std::move(progress.timings);
+  if (model) out.costModel = *model;
   out.devices = sampler.deviceShares();
   out.imbalanceSeconds = sampler.imbalanceSeconds();
   out.wallSeconds = secondsSince(start);

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "alloc/GridSearch.h"
@@ -16,7 +17,7 @@ struct AdaptiveOptions {
   int stages = 1;               // after the pilot
   int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
   double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
-  std::vector<double> costs;    // c_k per sample, one per technique
+  std::vector<double> costs;    // c_k per sample, one per technique (--cost); empty: the sampler's CostModel
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
   GridRule gridRule = GridRule::MinCostVariance;
@@ -26,6 +27,14 @@ struct AdaptiveOptions {
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError
 // if the budget cannot hold a pilot of two samples per technique plus one stage.
 std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount);
+
+// One stage's kernel time, and the cost model's prediction of it, made before it ran.
+struct StageTiming {
+  int samples = 0;  // per pixel
+  bool keptStatistics = false;
+  std::optional<double> predictedKernelSeconds;  // adaptive methods only
+  double kernelSeconds = 0;
+};
 
 struct Rendering {
   RgbImage image;
@@ -43,6 +52,8 @@ struct Rendering {
   double wallSeconds = 0;
   std::vector<DeviceShare> devices;  // where it ran (sampling/TiledSampler.h for several)
   double imbalanceSeconds = 0;       // several devices: Σ over stages of last finish − first finish
+  std::vector<StageTiming> stages;   // the pilot (or the oracle's probe) first
+  std::optional<CostModel> costModel;  // adaptive methods: what they allocated with, refitted on this render's stages
 };
 
 // Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods

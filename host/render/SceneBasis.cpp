@@ -1,6 +1,5 @@
 #include "render/SceneBasis.h"
 
-#include "sampling/Costs.h"
 
 namespace misalloc {
 
@@ -9,8 +8,8 @@ SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& requ
   if (request.findReference)
     basis.reference = findReference(plainScene, request.referenceSpp, request.cacheDir, makeSampler);
   if (!request.needsCosts) return basis;
-  basis.costSource = request.givenCosts.empty() ? "measured" : "--cost";
-  basis.costs = request.givenCosts.empty() ? measureCosts(*makeSampler(plainScene)) : request.givenCosts;
+  basis.costSource = request.givenCosts.empty() ? "calibrated" : "--cost";
+  basis.costs = request.givenCosts;
   return basis;
 }
 

@@ -14,8 +14,8 @@ namespace misalloc {
 
 struct SceneBasis {
   std::optional<Reference> reference;
-  std::vector<double> costs;  // c_k per sample; empty where no method allocates
-  std::string costSource;     // "measured" or "--cost"
+  std::vector<double> costs;  // --cost as given; empty: each sampler's own (sampling/CostModel.h)
+  std::string costSource;     // "calibrated" (on each sampler's launches) or "--cost"
 };
 
 struct SceneBasisRequest {
@@ -23,14 +23,13 @@ struct SceneBasisRequest {
   int referenceSpp = 16384;
   std::string cacheDir;
   bool needsCosts = false;         // some method allocates with costs
-  std::vector<double> givenCosts;  // --cost, used as given; measured when empty
+  std::vector<double> givenCosts;  // --cost, used as given; calibrated per sampler when empty
 };
 
-// The reference and the costs of `plainScene` (the scene with the plain envmap pdf:
-// [Kar19]'s pdf changes the noise, not the integral, so one reference and one cost
-// measurement serve every pdf). `makeSampler` builds a sampler without statistics for
-// the scene it is given, only where one is needed (a reference to compute, costs to
-// measure).
+// The reference of `plainScene` (the scene with the plain envmap pdf: [Kar19]'s pdf
+// changes the noise, not the integral, so one reference serves every pdf) and where the
+// costs come from. `makeSampler` builds a sampler without statistics for the scene it
+// is given, only where a reference is to be computed.
 SceneBasis findSceneBasis(const Scene& plainScene, const SceneBasisRequest& request, const SamplerFactory& makeSampler);
 
 }  // namespace misalloc

@@ -95,6 +95,34 @@ nlohmann::json timeSplitJson(double wall, double kernel, double allocation, doub
   return {{"wall", wall}, {"kernel", kernel}, {"allocation", allocation}, {"host", host}};
 }
 
+nlohmann::json stagesJson(const std::vector<StageTiming>& stages) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const StageTiming& s : stages) {
+    nlohmann::json entry = {{"samples", s.samples}, {"keeps_statistics", s.keptStatistics}, {"kernel_s", s.kernelSeconds}};
+    if (s.predictedKernelSeconds) {
+      entry["predicted_kernel_s"] = *s.predictedKernelSeconds;
+      entry["predicted_over_measured"] = *s.predictedKernelSeconds / s.kernelSeconds;
+    }
+    list.push_back(entry);
+  }
+  return list;
+}
+
+nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames,
+                             const std::string& source) {
+  nlohmann::json kernels;
+  for (bool statistics : {false, true}) {
+    nlohmann::json perSample;
+    for (size_t k = 0; k < techniqueNames.size(); ++k) perSample[techniqueNames[k]] = model.perSample(statistics)[k];
+    kernels[statistics ? "with_statistics" : "plain"] = {{"per_launch_s", model.perLaunch(statistics)},
+                                                         {"per_sample_s", perSample},
+                                                         {"launches_fitted", model.launchCount(statistics)}};
+  }
+  return {{"source", source},
+          {"model", "T = t_0 + sum_k c_k S_k, S_k: technique k's sample slots as the work-groups run them"},
+          {"kernels", kernels}};
+}
+
 nlohmann::json renderReport(const RenderRun& run) {
   const Rendering& r = run.rendering;
   const int pixels = run.scene.pixelCount(), M = run.scene.techniqueCount();
@@ -118,14 +146,16 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"mean_alpha", meanAlpha},
       {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
       {"devices", devicesJson(r)},
+      {"stages", stagesJson(r.stages)},
   };
   if (r.devices.size() > 1) {
     report["imbalance_s"] = r.imbalanceSeconds;
     report["imbalance_fraction"] = r.imbalanceSeconds / r.wallSeconds;
   }
   if (isAdaptive(run.method)) {
+    // The costs of the kernel without statistics, which runs the last stage.
     nlohmann::json costs;
-    for (int k = 0; k < M; ++k) costs[names[k]] = run.adaptive.costs[k];
+    for (int k = 0; k < M; ++k) costs[names[k]] = r.costModel->perSample(false)[k];
     report["allocation"] = {
         {"stages", r.stageCount},
         {"pilot_fraction", run.adaptive.pilotFraction},
@@ -133,6 +163,7 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"skip_below", run.adaptive.minGain},
         {"costs_s_per_sample", costs},
         {"costs_source", run.costSource},
+        {"cost_model", costModelJson(*r.costModel, names, run.costSource)},
         {"fallback_pixels", r.fallbackPixels},
         {"fallback_pixel_fraction", summary.fallbackFraction},
         {"floored_pixels", r.flooredPixels},

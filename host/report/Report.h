@@ -14,7 +14,7 @@ struct RenderRun {
   Method method;
   Estimator estimator;
   const AdaptiveOptions& adaptive;
-  std::string costSource;  // "measured" or "--cost"
+  std::string costSource;  // "calibrated" (each sampler's CostModel) or "--cost"
   int spp;
   uint64_t seed;
   std::string device;
@@ -26,6 +26,11 @@ struct RenderRun {
 // kernel, allocation and host time, the allocation's schedule, costs, mean α and
 // defensive-rule counts, and the errors against the reference when there is one.
 nlohmann::json renderReport(const RenderRun& run);
+// Each stage's kernel time and, for the adaptive methods, the cost model's prediction.
+nlohmann::json stagesJson(const std::vector<StageTiming>& stages);
+// The fitted (or given) costs of both kernels.
+nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames,
+                             const std::string& source);
 
 nlohmann::json sceneJson(const Scene& scene);
 

@@ -9,6 +9,7 @@
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
 #include "cl/LaunchShape.h"
+#include "sampling/LaunchWork.h"
 
 namespace misalloc {
 namespace {
@@ -110,31 +111,6 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   }
   reset();
 }
-
-namespace {
-
-// The order in which work-items take pixels. A work-group runs each technique's loop
-// for its largest count (kernels/sample.cl, sampleStage), so pixels with like counts
-// share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort, ties
-// by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
-// work-group, so the order changes the time only, never the result.
-std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
-  std::vector<int32_t> order(range.size());
-  std::iota(order.begin(), order.end(), range.begin);
-  const size_t M = size_t(plan.techniqueCount);
-  auto before = [&](int32_t a, int32_t b) {
-    const int* countsA = plan.counts.data() + size_t(a) * M;
-    const int* countsB = plan.counts.data() + size_t(b) * M;
-    return std::lexicographical_compare(countsA, countsA + M - 1, countsB, countsB + M - 1);
-  };
-  // A comparison sort: its memory scales with the pixels, where a counting sort's
-  // buckets 0..N took 4 bytes per sample of the stage. Fixed splits and the pilot are
-  // in order already, and a check is cheaper than the sort.
-  if (!std::is_sorted(order.begin(), order.end(), before)) std::stable_sort(order.begin(), order.end(), before);
-  return order;
-}
-
-}  // namespace
 
 StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
   const int M = scene_.techniqueCount();

@@ -50,6 +50,7 @@ class Sampler : public StageSampler {
   StoredSampleBuffer storedSampleBuffer() override { return {storedSampleDevice(), &samples_, nullptr}; }
 
   std::vector<DeviceShare> deviceShares() const override;
+  int launchGroupSize() const override { return localSize_; }
 
  protected:
   void forgetStages() override;

@@ -12,6 +12,18 @@ StageResult StageSampler::run(const StagePlan& plan, uint64_t seed) {
   return runPixels(plan, seed, takeSlots(plan), PixelRange{0, pixels});
 }
 
+LaunchWork StageSampler::launchWork(const StagePlan& plan) const {
+  LaunchWork work = misalloc::launchWork(plan, config_.estimator, launchGroupSize());
+  // A sampler that keeps no statistics runs its one kernel whatever the plan says.
+  work.keepsStatistics = work.keepsStatistics && keepsStatistics(config_);
+  return work;
+}
+
+CostModel& StageSampler::costModel() {
+  if (!costModel_) costModel_ = calibrateCostModel(*this);
+  return *costModel_;
+}
+
 void StageSampler::reset() {
   forgetSlots();
   forgetStages();

@@ -1,7 +1,10 @@
 #pragma once
 #include <cstdint>
+#include <optional>
 
+#include "sampling/CostModel.h"
 #include "sampling/DeviceReport.h"
+#include "sampling/LaunchWork.h"
 #include "sampling/Stage.h"
 #include "sampling/StageStatistics.h"
 
@@ -25,9 +28,22 @@ class StageSampler : public StageStatistics, public DeviceReport {
   // caller.
   virtual StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) = 0;
 
+  // What a launch of `plan` executes, as this sampler runs it (LaunchWork.h).
+  LaunchWork launchWork(const StagePlan& plan) const;
+  // The model of this sampler's launch times, calibrated at the first call
+  // (calibrateCostModel) and kept, for the renders to refit on their stages: the same
+  // kernels on the same scene.
+  CostModel& costModel();
+
+  // The pixels that run a technique's loop together: a work-group (Sampler).
+  virtual int launchGroupSize() const { return 1; }
+
  protected:
   // Clears the running sums and device shares.
   virtual void forgetStages() = 0;
+
+ private:
+  std::optional<CostModel> costModel_;
 };
 
 }  // namespace misalloc

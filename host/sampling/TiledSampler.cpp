@@ -173,6 +173,12 @@ StoredSampleBuffer TiledSampler::storedSampleBuffer() {
   return members_[0]->storedSampleBuffer();
 }
 
+int TiledSampler::launchGroupSize() const {
+  int largest = 1;
+  for (const auto& member : members_) largest = std::max(largest, member->launchGroupSize());
+  return largest;
+}
+
 void TiledSampler::forgetStages() {
   for (size_t d = 0; d < members_.size(); ++d)
     if (live(d)) members_[d]->reset();

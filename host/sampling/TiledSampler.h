@@ -40,6 +40,8 @@ class TiledSampler : public StageSampler {
 
   std::vector<DeviceShare> deviceShares() const override;
   double imbalanceSeconds() const override { return imbalanceSeconds_; }
+  // Tiles run on every member at once: work-groups taken as large as the largest.
+  int launchGroupSize() const override;
 
  private:
   void forgetStages() override;

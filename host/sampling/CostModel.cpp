@@ -1,0 +1,150 @@
+#include "sampling/CostModel.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "Error.h"
+#include "NumberList.h"
+#include "sampling/StageSampler.h"
+
+namespace misalloc {
+
+CostModel CostModel::given(std::vector<double> costs) {
+  CostModel model(int(costs.size()));
+  for (Kernel& k : model.kernels_) k.perSample = costs;
+  model.given_ = true;
+  return model;
+}
+
+CostModel::CostModel(int techniqueCount) {
+  for (Kernel& k : kernels_) k.perSample.assign(techniqueCount, 0.0);
+}
+
+void CostModel::observe(const LaunchWork& work, double seconds) {
+  if (given_ || !(seconds > 0)) return;
+  Kernel& k = kernels_[work.keepsStatistics ? 1 : 0];
+  k.seen.push_back({work.slots, seconds});
+  fit(k);
+}
+
+double CostModel::predict(const LaunchWork& work) const {
+  const Kernel& k = kernel(work.keepsStatistics);
+  double seconds = k.perLaunch;
+  for (size_t i = 0; i < work.slots.size(); ++i) seconds += k.perSample[i] * work.slots[i];
+  return seconds;
+}
+
+// Least squares on the relative error, (T̂ − T)/T, so that short launches weigh as much
+// as long ones. Unknowns x = (t_0, c_0, …, c_{M−1}), none negative: an unknown that
+// comes out negative leaves the fit (t_0 first, which noise on launches of few
+// samples drives below zero) and the rest are fitted again.
+void CostModel::fit(Kernel& kernel) {
+  const int M = int(kernel.perSample.size()), unknowns = M + 1, n = int(kernel.seen.size());
+  Eigen::MatrixXd a(n, unknowns);
+  for (int i = 0; i < n; ++i) {
+    const Launch& launch = kernel.seen[i];
+    a(i, 0) = 1 / launch.seconds;
+    for (int k = 0; k < M; ++k) a(i, 1 + k) = launch.slots[k] / launch.seconds;
+  }
+  std::vector<int> free;
+  for (int j = n > M ? 0 : 1; j < unknowns; ++j) free.push_back(j);  // t_0 only with a launch to spare
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(unknowns);
+  while (!free.empty()) {
+    Eigen::MatrixXd sub(n, int(free.size()));
+    for (size_t j = 0; j < free.size(); ++j) sub.col(int(j)) = a.col(free[j]);
+    const Eigen::VectorXd solution = sub.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(n));
+    x.setZero();
+    for (size_t j = 0; j < free.size(); ++j) x(free[j]) = solution(int(j));
+    auto leaving = free.end();
+    for (auto j = free.begin(); j != free.end(); ++j)
+      if (*j == 0 ? x(0) < 0 : x(*j) <= 0) {
+        if (*j == 0 || leaving == free.end() || (*leaving != 0 && x(*j) < x(*leaving))) leaving = j;
+      }
+    if (leaving == free.end()) break;
+    x(*leaving) = 0;
+    free.erase(leaving);
+  }
+  kernel.perLaunch = x(0);
+  // A technique whose samples the fit cannot tell from free (its time within the
+  // noise of the others') costs what the cheapest measured one does: every cost > 0.
+  double cheapest = 0;
+  for (int k = 0; k < M; ++k)
+    if (x(1 + k) > 0 && (cheapest == 0 || x(1 + k) < cheapest)) cheapest = x(1 + k);
+  for (int k = 0; k < M; ++k) kernel.perSample[k] = x(1 + k) > 0 ? x(1 + k) : cheapest;
+}
+
+namespace {
+
+StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bool keepStatistics) {
+  StagePlan plan;
+  plan.techniqueCount = scene.techniqueCount();
+  plan.keepStatistics = keepStatistics;
+  for (int n : counts) plan.stageSamples += n;
+  for (int p = 0; p < scene.pixelCount(); ++p) plan.counts.insert(plan.counts.end(), counts.begin(), counts.end());
+  plan.firstIndex.assign(plan.counts.size(), 0u);
+  return plan;
+}
+
+// Samples per technique that make a launch of every pixel last about 10 ms, from one
+// launch of one sample per technique.
+int calibrationSize(StageSampler& sampler, int capacity) {
+  const Scene& scene = sampler.scene();
+  StagePlan probe = calibrationPlan(scene, std::vector<int>(scene.techniqueCount(), 1), false);
+  const double seconds = sampler.run(probe, 0).kernelSeconds;
+  constexpr double kLaunchSeconds = 0.01;
+  return std::clamp(int(std::lround(kLaunchSeconds / std::max(seconds, 1e-6))), 1, std::max(1, capacity / 4));
+}
+
+}  // namespace
+
+CostModel calibrateCostModel(StageSampler& sampler) {
+  const Scene& scene = sampler.scene();
+  const int M = scene.techniqueCount();
+  const bool withStatistics = keepsStatistics(sampler.config());
+  // A stage that keeps statistics stores its samples: the shapes fit in the slots.
+  const int capacity = withStatistics && sampler.config().sampleCapacity > 0 ? sampler.config().sampleCapacity
+                                                                             : std::numeric_limits<int>::max() / 8;
+  const int size = calibrationSize(sampler, capacity / M);
+  std::vector<StagePlan> shapes;
+  // Each technique alone at two sizes, where the stored samples' slots allow.
+  const int large = std::min(4 * size, capacity / M);
+  for (bool statistics : {false, true}) {
+    if (statistics && !withStatistics) continue;
+    for (int k = 0; k < M; ++k)
+      for (int n : {size, large}) {
+        if (n == large && large == size) continue;
+        std::vector<int> counts(M, 0);
+        counts[k] = n;
+        shapes.push_back(calibrationPlan(scene, counts, statistics));
+      }
+    shapes.push_back(calibrationPlan(scene, std::vector<int>(M, size), statistics));
+  }
+  constexpr int kRounds = 3;
+  std::vector<std::vector<double>> seconds(shapes.size());
+  for (int round = 0; round < kRounds; ++round)
+    for (size_t s = 0; s < shapes.size(); ++s) {
+      sampler.reset();
+      seconds[s].push_back(sampler.run(shapes[s], uint64_t(round)).kernelSeconds);
+    }
+  sampler.reset();
+  CostModel model(M);
+  for (size_t s = 0; s < shapes.size(); ++s) {
+    // The median round of each shape, which a round slowed by another process does not move.
+    std::nth_element(seconds[s].begin(), seconds[s].begin() + kRounds / 2, seconds[s].end());
+    model.observe(sampler.launchWork(shapes[s]), seconds[s][kRounds / 2]);
+  }
+  return model;
+}
+
+std::vector<double> parseCosts(const std::string& list, int techniqueCount) {
+  std::vector<double> costs = parseNumberList("--cost", list, list, size_t(techniqueCount), "one cost per technique");
+  for (double c : costs)
+    if (c <= 0) throw InputError(fmt::format("--cost {}: costs must be positive, got {}", list, c));
+  return costs;
+}
+
+}  // namespace misalloc

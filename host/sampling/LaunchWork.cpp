@@ -1,0 +1,44 @@
+#include "sampling/LaunchWork.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace misalloc {
+
+std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
+  std::vector<int32_t> order(range.size());
+  std::iota(order.begin(), order.end(), range.begin);
+  const size_t M = size_t(plan.techniqueCount);
+  auto before = [&](int32_t a, int32_t b) {
+    const int* countsA = plan.counts.data() + size_t(a) * M;
+    const int* countsB = plan.counts.data() + size_t(b) * M;
+    return std::lexicographical_compare(countsA, countsA + M - 1, countsB, countsB + M - 1);
+  };
+  // A comparison sort: its memory scales with the pixels, where a counting sort's
+  // buckets 0..N took 4 bytes per sample of the stage. Fixed splits and the pilot are
+  // in order already, and a check is cheaper than the sort.
+  if (!std::is_sorted(order.begin(), order.end(), before)) std::stable_sort(order.begin(), order.end(), before);
+  return order;
+}
+
+LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize) {
+  const int M = plan.techniqueCount;
+  const int pixels = int(plan.counts.size() / size_t(M));
+  LaunchWork work{plan.keepStatistics, std::vector<double>(M, 0.0)};
+  if (estimator == Estimator::OneSample || groupSize <= 1) {
+    for (int p = 0; p < pixels; ++p)
+      for (int k = 0; k < M; ++k) work.slots[k] += plan.counts[size_t(p) * M + k];
+    return work;
+  }
+  const std::vector<int32_t> order = coherentPixelOrder(plan, {0, pixels});
+  for (int first = 0; first < pixels; first += groupSize)
+    for (int k = 0; k < M; ++k) {
+      int largest = 0;
+      for (int i = first; i < std::min(pixels, first + groupSize); ++i)
+        largest = std::max(largest, int(plan.counts[size_t(order[i]) * M + k]));
+      work.slots[k] += double(groupSize) * largest;
+    }
+  return work;
+}
+
+}  // namespace misalloc

@@ -1,0 +1,31 @@
+#pragma once
+// How the sampling kernel walks a stage's pixels, and the work a launch does: what the
+// cost model (CostModel.h) predicts a launch's time from.
+#include <cstdint>
+#include <vector>
+
+#include "sampling/Stage.h"
+
+namespace misalloc {
+
+// The order in which work-items take the pixels of `range`. A work-group runs each
+// technique's loop for its largest count (kernels/sample.cl, sampleStage), so pixels
+// with like counts share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort,
+// ties by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
+// work-group, so the order changes the time only, never the result.
+std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range);
+
+// What one launch executes: per technique, the sample slots Σ over work-groups of
+// (group size) · (the group's largest n_k), padding work-items included: a work-item
+// whose own n_k is smaller runs the loop too, its surplus samples not counted. The
+// one-sample estimator runs one pass of N samples, each of the technique it draws; its
+// slots are the counts' expectation.
+struct LaunchWork {
+  bool keepsStatistics = false;  // the kernel with running sums and stored samples
+  std::vector<double> slots;     // [k]
+};
+
+// `groupSize` 1: a sampler that runs each pixel's counts alone (HostSampler).
+LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize);
+
+}  // namespace misalloc

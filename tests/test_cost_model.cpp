@@ -1,0 +1,148 @@
+// The cost model (sampling/CostModel.h): the work a launch does as its work-groups run
+// it (sampling/LaunchWork.h), the fit on synthetic timing tables with a known answer,
+// and the calibration and per-stage predictions of a real render.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "render/Render.h"
+#include "sampling/CostModel.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+StagePlan planOf(const std::vector<std::vector<int>>& counts, bool keepStatistics = false) {
+  StagePlan plan;
+  plan.techniqueCount = int(counts.front().size());
+  plan.keepStatistics = keepStatistics;
+  for (int n : counts.front()) plan.stageSamples += n;
+  for (const auto& pixel : counts) plan.counts.insert(plan.counts.end(), pixel.begin(), pixel.end());
+  plan.firstIndex.assign(plan.counts.size(), 0u);
+  return plan;
+}
+
+LaunchWork work(std::vector<double> slots, bool keepsStatistics = false) { return {keepsStatistics, std::move(slots)}; }
+
+// T = t_0 + Σ_k c_k S_k, exactly.
+double launchSeconds(double perLaunch, const std::vector<double>& perSample, const LaunchWork& w) {
+  double t = perLaunch;
+  for (size_t k = 0; k < perSample.size(); ++k) t += perSample[k] * w.slots[k];
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("a launch's work is each work-group's largest count per technique", "[costmodel]") {
+  // Sorted by n_0: (1,3) (2,2) | (3,1) (3,1); groups of two run (2,3) and (3,1).
+  const StagePlan plan = planOf({{3, 1}, {1, 3}, {2, 2}, {3, 1}}, true);
+  const LaunchWork grouped = launchWork(plan, Estimator::MultiSample, 2);
+  CHECK(grouped.keepsStatistics);
+  CHECK(grouped.slots == std::vector<double>{2 * 2 + 2 * 3, 2 * 3 + 2 * 1});
+  // A sampler that runs each pixel alone, and the one-sample estimator's single pass,
+  // do the counts.
+  CHECK(launchWork(plan, Estimator::MultiSample, 1).slots == std::vector<double>{9, 7});
+  CHECK(launchWork(plan, Estimator::OneSample, 8).slots == std::vector<double>{9, 7});
+  // The last group's padding work-items repeat a pixel of the group: no extra work.
+  CHECK(launchWork(planOf({{4, 0}, {1, 3}, {2, 2}}), Estimator::MultiSample, 2).slots ==
+        std::vector<double>{2 * 2 + 2 * 4, 2 * 3 + 2 * 0});
+}
+
+TEST_CASE("the cost model recovers the costs of a synthetic timing table", "[costmodel]") {
+  const double t0 = 2e-3;
+  const std::vector<double> c{7.5e-8, 2.5e-8, 4e-8};
+  CostModel model(3);
+  for (const LaunchWork& w : {work({1e5, 0, 0}), work({4e5, 0, 0}), work({0, 1e5, 0}), work({0, 4e5, 0}),
+                              work({0, 0, 2e5}), work({1e5, 1e5, 1e5})})
+    model.observe(w, launchSeconds(t0, c, w));
+  CHECK(model.launchCount(false) == 6);
+  CHECK(model.perLaunch(false) == Approx(t0).epsilon(1e-9));
+  for (int k = 0; k < 3; ++k) CHECK(model.perSample(false)[k] == Approx(c[k]).epsilon(1e-9));
+  const LaunchWork unseen = work({3e6, 1e6, 5e5});
+  CHECK(model.predict(unseen) == Approx(launchSeconds(t0, c, unseen)).epsilon(1e-9));
+  // The other kernel has seen nothing: its fit is its own.
+  CHECK(model.launchCount(true) == 0);
+  CHECK(model.predict(work({1e5, 1e5, 1e5}, true)) == 0);
+}
+
+TEST_CASE("the fit keeps every cost positive", "[costmodel]") {
+  SECTION("an intercept below zero leaves the fit") {
+    // Launches that take less than their samples' share: t_0 < 0 fits them best.
+    CostModel model(2);
+    for (const LaunchWork& w : {work({1e5, 0}), work({4e5, 0}), work({0, 1e5}), work({0, 4e5})})
+      model.observe(w, launchSeconds(-1e-3, {5e-8, 2e-8}, w));
+    CHECK(model.perLaunch(false) == 0);
+    CHECK(model.perSample(false)[0] > 0);
+    CHECK(model.perSample(false)[1] > 0);
+  }
+  SECTION("a technique that seems to save time costs what the cheapest does") {
+    CostModel model(2);
+    for (const LaunchWork& w : {work({1e5, 0}), work({4e5, 0}), work({1e5, 1e5}), work({1e5, 4e5})})
+      model.observe(w, launchSeconds(1e-3, {5e-8, -1e-9}, w));
+    CHECK(model.perSample(false)[1] == model.perSample(false)[0]);
+    CHECK(model.perSample(false)[0] > 0);
+  }
+  SECTION("with no launch to spare, no intercept") {
+    CostModel model(2);
+    model.observe(work({1e5, 0}), 0.01);
+    model.observe(work({0, 1e5}), 0.002);
+    CHECK(model.perLaunch(false) == 0);
+    CHECK(model.perSample(false)[0] == Approx(1e-7));
+    CHECK(model.perSample(false)[1] == Approx(2e-8));
+  }
+}
+
+TEST_CASE("given costs are used as given", "[costmodel]") {
+  CostModel model = CostModel::given({3e-8, 1e-8});
+  model.observe(work({1e5, 1e5}), 1.0);
+  CHECK(model.isGiven());
+  CHECK(model.perLaunch(false) == 0);
+  CHECK(model.perSample(true) == std::vector<double>{3e-8, 1e-8});
+  CHECK(model.predict(work({1e5, 2e5})) == Approx(5e-3));
+}
+
+TEST_CASE("a render calibrates its sampler's model and predicts every stage", "[costmodel]") {
+  const Scene scene = smallScene("cosk:4", "seed000", 64, 64);
+  AdaptiveOptions options;
+  options.stages = 2;
+  const int spp = 64;
+  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, spp, options));
+  const Rendering r = render(sampler, Method::Exact, options, spp, 1);
+  REQUIRE(r.costModel);
+  CHECK_FALSE(r.costModel->isGiven());
+  for (bool statistics : {false, true}) {
+    // Both kernels calibrated on 2M + 1 shapes, then refitted on the render's stages.
+    CHECK(r.costModel->launchCount(statistics) > 2 * scene.techniqueCount());
+    for (double c : r.costModel->perSample(statistics)) CHECK(c > 0);
+  }
+  REQUIRE(r.stages.size() == 3);
+  CHECK(r.stages[0].keptStatistics);
+  CHECK_FALSE(r.stages[2].keptStatistics);
+  int samples = 0;
+  for (const StageTiming& t : r.stages) {
+    REQUIRE(t.predictedKernelSeconds);
+    CHECK(*t.predictedKernelSeconds > 0);
+    CHECK(t.kernelSeconds > 0);
+    samples += t.samples;
+  }
+  CHECK(samples == spp);
+
+  SECTION("a second render refits the sampler's model on its stages, without calibrating again") {
+    const int plain = sampler.costModel().launchCount(false), statistics = sampler.costModel().launchCount(true);
+    render(sampler, Method::Exact, options, spp, 2);
+    CHECK(sampler.costModel().launchCount(false) == plain + 1);
+    CHECK(sampler.costModel().launchCount(true) == statistics + 2);
+  }
+}
+
+TEST_CASE("fixed splits are timed but not predicted", "[costmodel]") {
+  const Scene scene = smallScene("cosk:4", "seed000", 32, 32);
+  AdaptiveOptions options;
+  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options));
+  const Rendering r = render(sampler, Method::Equal, options, 16, 1);
+  REQUIRE(r.stages.size() == 1);
+  CHECK_FALSE(r.stages[0].predictedKernelSeconds);
+  CHECK_FALSE(r.costModel);
+}
