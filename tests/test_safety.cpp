@@ -165,9 +165,9 @@ TEST_CASE("radiance near the float maximum is refused, naming the input; written
       }
     }
   }
-  // Whatever was cached is finite (readExr refuses NaN and Inf).
-  if (fs::exists(w.dir.path / "cache"))
-    for (const auto& entry : fs::recursive_directory_iterator(w.dir.path / "cache"))
+  // Whatever reference was cached is finite (readExr refuses NaN and Inf).
+  if (fs::exists(w.dir.path / "cache" / "references"))
+    for (const auto& entry : fs::recursive_directory_iterator(w.dir.path / "cache" / "references"))
       if (entry.is_regular_file()) CHECK_NOTHROW(misalloc::readExr(entry.path().string()));
   // The brightest map accepted renders finite pixels at the most extreme lobes.
   auto r = runMisalloc(fmt::format(

@@ -86,6 +86,7 @@ int runCompare(CompareArgs& args) {
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
   compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(args.envmapPdfs));
+  for (CompareCase& c : compare.cases) c.scene.bankCacheDir = compare.cacheDir;
   compare.methods = parseMethodList(args.methods);
   compare.budgets = parseBudgets(args.budgets);
   // The reference's own variance, about that of a render of as many samples with the
@@ -158,7 +159,7 @@ Subcommand addCompareCommand(CLI::App& app) {
                       "spp of a sampled reference (default: 64 x the largest budget, at least 16384)")
       ->check(integerIn(1, INT_MAX));
   compare.cacheDir = defaultCacheDir();
-  command->add_option("--cache-dir", compare.cacheDir, "where references are cached")->capture_default_str();
+  command->add_option("--cache-dir", compare.cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
   return {command, [args] { return runCompare(*args); }};
 }
 

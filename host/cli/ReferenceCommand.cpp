@@ -30,6 +30,7 @@ int runReference(ReferenceArgs& args) {
   exitOnInterrupt();
   OutputSet outputs(envmapInputs({args.scene.parsed()}));
   if (!args.out.empty()) outputs.claim("--out", args.out);
+  args.scene.options.bankCacheDir = args.cacheDir;
   Scene scene = args.scene.make();
   if (auto cached = referenceCachePath(scene, args.spp, args.cacheDir))
     outputs.addInput({"the cached reference (--cache-dir)", *cached});
@@ -38,6 +39,7 @@ int runReference(ReferenceArgs& args) {
   });
   if (!args.out.empty()) outputs.put(args.out, encodeExr(reference.image));
   outputs.commit();
+  cacheOptimalBank(scene);
   std::cout << fmt::format("reference: {}{}\n", reference.source,
                            reference.path.empty() ? "" : " at " + reference.path);
   return 0;
@@ -51,7 +53,7 @@ Subcommand addReferenceCommand(CLI::App& app) {
   args->scene.add(*command);
   command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
   args->devices.add(*command, "comma-separated: auto, cpu, gpu, index, host, all or D:N");
-  command->add_option("--cache-dir", args->cacheDir, "where references are cached")->capture_default_str();
+  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
   command->add_option("--out", args->out, "also write the reference to this EXR");
   return {command, [args] { return runReference(*args); }};
 }

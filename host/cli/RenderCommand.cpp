@@ -65,6 +65,7 @@ int runRender(RenderArgs& args) {
     outputs.claim("--alpha-map", args.alphaMap);
     outputs.claim("--alpha-map", alphaPngPath(args.alphaMap));
   }
+  args.scene.options.bankCacheDir = args.cacheDir;
   Scene scene = args.scene.make();
   AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
   requireValidRun(scene.options, m, estimator, args.spp, adaptive);
@@ -102,6 +103,7 @@ int runRender(RenderArgs& args) {
   }
   outputs.put(args.report, jsonText(report));
   outputs.commit();
+  cacheOptimalBank(scene);
   std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s, allocation {:.3f} s)\n",
                            deviceName, scene.options.envmap, scene.options.grid, scene.grid.width, scene.grid.height,
                            args.spp, traits.name, r.wallSeconds, r.kernelSeconds, r.allocationSeconds);
@@ -145,7 +147,7 @@ Subcommand addRenderCommand(CLI::App& app) {
   command->add_option("--reference-spp", args->referenceSpp, "spp of a sampled reference")
       ->capture_default_str()
       ->check(integerIn(1, INT_MAX));
-  command->add_option("--cache-dir", args->cacheDir, "where references are cached")->capture_default_str();
+  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
   command->add_option("--local-size", args->localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
   return {command, [args] { return runRender(*args); }};
 }

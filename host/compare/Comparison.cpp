@@ -212,6 +212,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
           meter.step(fmt::format("{} {} {} spp #{}", c.label, methodName(method), budget, r + 1));
         }
     }
+    cacheOptimalBank(scene);
   }
   return out;
 }

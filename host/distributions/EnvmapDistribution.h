@@ -48,7 +48,8 @@ struct EnvmapTables {
   std::vector<float> blockProbs{0};  // per entry, per block (never empty: an OpenCL buffer)
   std::vector<int> brdfBinOfPixel;   // the kernels read it as the 4th float of the pixel's BRDF
   BankVariances bankVariances;
-  double bankBuildSeconds = 0;  // building every table from the map's luminance
+  double bankBuildSeconds = 0;  // building every table from the map's luminance, or reading them (bankFromCache)
+  bool bankFromCache = false;   // read from the bank cache (BankCache.h)
 
   bool hasBank() const { return bankShares > 0; }
 };

@@ -47,6 +47,7 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
                    // The sampling tables beside the texels: a plain alias table holds 8 B per texel.
                    {"table_bytes", (tables.aliasTable.size() + tables.cdfTable.size() + tables.blockProbs.size()) * 4},
                    {"build_seconds", tables.bankBuildSeconds},
+                   {"from_cache", tables.bankFromCache},
                    {"one_sample_variance_eq6_over_eq9_max", v.compensatedOverOptimalMax},
                    {"one_sample_variance_eq6_over_eq9_mean", v.compensatedOverOptimalMean},
                    {"entries_with_negative_eq5", v.entriesWithNegativeEq5}};

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "Error.h"
+#include "distributions/BankCache.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
@@ -81,7 +82,13 @@ Scene makeScene(const SceneOptions& options) {
       throw InputError(
           "--envmap-pdf optimal with --split-brdf: not implemented; the optimal pdf's bank is built "
           "for the BRDF as one technique (M = 2)");
-    scene.tables = buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
+    std::optional<EnvmapTables> cached;
+    if (!options.bankCacheDir.empty()) {
+      scene.bankCacheKey = bankCacheKey(scene.envmap, options.sampler, scene.grid, scene.mirror);
+      cached = readCachedBank(options.bankCacheDir, scene.bankCacheKey, scene.envmap.image);
+    }
+    scene.tables = cached ? std::move(*cached)
+                          : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
@@ -90,6 +97,11 @@ Scene makeScene(const SceneOptions& options) {
   // for the plain tables of the reference and the costs (withPlainEnvmapPdf).
   if (options.envmapPdf.plain()) scene.envmap.image.rgb = std::vector<float>();
   return scene;
+}
+
+void cacheOptimalBank(const Scene& scene) {
+  if (!scene.bankCacheKey.empty() && !scene.tables.bankFromCache)
+    writeCachedBank(scene.options.bankCacheDir, scene.bankCacheKey, scene.tables);
 }
 
 Scene withPlainEnvmapPdf(const Scene& scene) {

@@ -18,6 +18,9 @@ struct SceneOptions {
   EnvmapSampler sampler = EnvmapSampler::Alias;
   EnvmapPdf envmapPdf;  // [Kar19]: plain, or compensated for MIS with BRDF sampling
   int proceduralWidth = 512;
+  // Where the optimal pdf's tables are cached (distributions/BankCache.h); empty: built
+  // every time. Not part of the scene: the same tables either way.
+  std::string bankCacheDir;
 
   // M: envmap sampling and BRDF sampling, or the envmap and each of the BRDF's two lobes.
   int techniqueCount() const { return splitBrdf ? 3 : 2; }
@@ -32,13 +35,20 @@ struct Scene {
   BrdfGrid grid;
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
+  std::string bankCacheKey;     // where the optimal pdf's tables were looked up in SceneOptions::bankCacheDir
 
   int techniqueCount() const { return options.techniqueCount(); }
   int pixelCount() const { return grid.width * grid.height; }
   std::vector<std::string> techniqueNames() const;
 };
 
+// Builds the scene, reading the optimal pdf's tables from SceneOptions::bankCacheDir
+// where they are cached there.
 Scene makeScene(const SceneOptions& options);
+
+// Writes the optimal pdf's tables to the cache where makeScene built them: after a run
+// has done its work, so that a refused or failed run writes no cache entry.
+void cacheOptimalBank(const Scene& scene);
 
 // The scene with the plain envmap pdf, for the reference: the pdf changes the noise,
 // not the integral, and a reference computed once must not depend on which pdf asked
