@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "Constants.h"
 #include "Error.h"
 
 namespace misalloc {
@@ -40,7 +41,6 @@ std::string envmapPdfName(const EnvmapPdf& pdf) {
 }
 
 double solidAngleMeanLuminance(const std::vector<double>& luminance, int width, int height) {
-  constexpr double kPi = 3.14159265358979323846;
   double integral = 0;  // ∫ L dω / (2π/W)
   for (int row = 0; row < height; ++row) {
     double rowSum = 0;

@@ -10,13 +10,13 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "Constants.h"
 #include "Error.h"
 #include "distributions/AliasTable.h"
 
 namespace misalloc {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
 

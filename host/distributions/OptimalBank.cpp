@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "Constants.h"
 #include "KernelCode.h"
 #include "distributions/CompensatedPdf.h"
 
 namespace misalloc {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // x in [lo, hi] cut into `bins` equal bins: the index of the one holding x (its nearest
 // centre). One bin where the range is empty.

@@ -3,13 +3,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "Constants.h"
 #include "distributions/CompensatedPdf.h"
 #include "paper/Quadrature.h"
 
 namespace misalloc {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kBins = 256;
 constexpr double kBinWidth = 2 * kPi / kBins;
 constexpr int kNodesPerBin = 20;

@@ -6,11 +6,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "Constants.h"
+
 namespace misalloc {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 const std::vector<double> kHavranSbertCosts = {1, 6.24, 3.28};  // [HS14] App. C, measured in C++
 
 double parabola(double x) { return x * x - x / kPi; }  // h₂ = x² − x/π
