@@ -8,16 +8,19 @@
 #include <optional>
 
 #include "Error.h"
+#include "Interruption.h"
 #include "JsonText.h"
 #include "OptionRange.h"
-#include "Interruption.h"
 #include "OutputSet.h"
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
 #include "cli/EnvmapInputs.h"
+#include "cli/RunIdentity.h"
 #include "cli/SceneArgs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
+#include "render/Band.h"
+#include "render/BandFile.h"
 #include "render/Method.h"
 #include "render/Reference.h"
 #include "render/Render.h"
@@ -40,8 +43,25 @@ struct RenderArgs {
   uint64_t seed = 1;
   bool noPreview = false;
   std::string method = "exact", estimator = "multi", out = "render.exr", report = "render.json", reference = "auto",
-              cacheDir = defaultCacheDir(), alphaMap;
+              cacheDir = defaultCacheDir(), alphaMap, shard;
+  std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
+
+// A sharded render's band (render/Band.h): what it may not be asked for, and where its
+// costs come from, checked before any work.
+std::optional<Band> requestedBand(RenderArgs& args, Method m, const AdaptiveOptions& adaptive, int height) {
+  if (args.shard.empty()) return std::nullopt;
+  if (!args.alphaMap.empty()) throw InputError("--alpha-map: a band of a sharded render (--shard) writes no alpha map");
+  // Costs measured by each band on its own node would differ, and so would the bands'
+  // allocations: a seam. Every band takes the same costs.
+  if (methodTraits(m).adaptive() && adaptive.costs.empty())
+    throw InputError(
+        fmt::format("--shard with --method {}: give the costs with --cost (every band must allocate with "
+                    "the same costs; a render's report has them as costs_s_per_sample)",
+                    args.method));
+  args.noPreview = true;
+  return bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(m, adaptive));
+}
 
 Estimator parseEstimator(const std::string& name) {
   if (name == "multi") return Estimator::MultiSample;
@@ -60,14 +80,15 @@ int runRender(RenderArgs& args) {
   OutputSet outputs(inputs);
   outputs.claim("--out", args.out);
   outputs.claim("--report", args.report);
+  Scene scene = args.scene.make();
+  AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
+  requireValidRun(scene.options, m, estimator, args.spp, adaptive);
+  const std::optional<Band> band = requestedBand(args, m, adaptive, scene.grid.height);
   if (!args.noPreview) outputs.claim("the preview (--no-preview skips it)", previewPath(args.out));
   if (!args.alphaMap.empty()) {
     outputs.claim("--alpha-map", args.alphaMap);
     outputs.claim("--alpha-map", alphaPngPath(args.alphaMap));
   }
-  Scene scene = args.scene.make();
-  AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
-  requireValidRun(scene.options, m, estimator, args.spp, adaptive);
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
@@ -82,7 +103,9 @@ int runRender(RenderArgs& args) {
     reference = Reference{readExr(args.reference), {}, "file", args.reference};
     checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
   }
-  auto sampler = args.devices.makeSampler(scene, config, args.localSize);
+  // A band renders its rows and those its pooling reads, with the image's random numbers.
+  const Scene renderedScene = band ? bandScene(scene, band->rendered) : scene;
+  auto sampler = args.devices.makeSampler(renderedScene, config, args.localSize);
   std::string deviceName = args.devices.name();
   SceneBasis basis = findSceneBasis(
       plainScene, {args.reference == "auto", args.referenceSpp, args.cacheDir, traits.adaptive(), adaptive.costs},
@@ -90,11 +113,26 @@ int runRender(RenderArgs& args) {
   if (basis.reference) reference = std::move(basis.reference);
   adaptive.costs = basis.costs;
   Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);
-  nlohmann::json report =
-      renderReport({scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});
-  outputs.put(args.out, encodeExr(r.image));
+  const int width = scene.grid.width, height = scene.grid.height;
+  if (band) {
+    // The band's report is of its own rows, as a scene of their own.
+    r = cropRendering(r, width, scene.techniqueCount(), band->rendered, band->rows);
+    if (reference) reference = cropReference(*reference, band->rows);
+    scene = bandScene(scene, band->rows);
+  }
+  nlohmann::json report = renderReport(
+      {scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});
+  if (band) {
+    report["band"] = {{"shard", args.shard},
+                      {"rows", {band->rows.begin, band->rows.end}},
+                      {"rendered_rows", {band->rendered.begin, band->rendered.end}}};
+    outputs.put(args.out, encodeBand(r.image, {args.run, *band, width, height, nodeName(), report}));
+  } else {
+    outputs.put(args.out, encodeExr(r.image));
+  }
   if (!args.noPreview)
-    outputs.put(previewPath(args.out), encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));
+    outputs.put(previewPath(args.out),
+                encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));
   if (!args.alphaMap.empty()) {
     AlphaMapFiles alpha = encodeAlphaMaps(scene, r);
     outputs.put(args.alphaMap, std::move(alpha.exr));
@@ -110,9 +148,9 @@ int runRender(RenderArgs& args) {
         "RMSE x1000 {:.3f}, {:.3f} corrected for the reference's own error, relative MSE {:.4g} (reference: {})\n",
         report["rmse_x1000"].get<double>(), report["rmse_x1000_corrected"].get<double>(),
         report["relative_mse"].get<double>(), reference->source);
-  std::cout << fmt::format("wrote {}{}, {}{}\n", args.out, args.noPreview ? "" : ", " + previewPath(args.out),
-                           args.report,
-                           args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
+  std::cout << fmt::format(
+      "wrote {}{}, {}{}\n", args.out, args.noPreview ? "" : ", " + previewPath(args.out), args.report,
+      args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
   return 0;
 }
 
@@ -147,7 +185,13 @@ Subcommand addRenderCommand(CLI::App& app) {
       ->check(integerIn(1, INT_MAX));
   command->add_option("--cache-dir", args->cacheDir, "where references are cached")->capture_default_str();
   command->add_option("--local-size", args->localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
-  return {command, [args] { return runRender(*args); }};
+  command->add_option("--shard", args->shard,
+                      "K/N: render band K of N (whole rows of 16-pixel blocks) into --out, for `misalloc merge`");
+  return {command, [args, command] {
+            args->run = runIdentity(*command, {"--shard", "--out", "--report", "--no-preview", "--cache-dir",
+                                               "--reference", "--reference-spp", "--help"});
+            return runRender(*args);
+          }};
 }
 
 }  // namespace misalloc

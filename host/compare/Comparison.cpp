@@ -9,6 +9,7 @@
 #include "Error.h"
 #include "JsonText.h"
 #include "compare/ProgressMeter.h"
+#include "render/BandFile.h"
 #include "render/Reference.h"
 #include "render/RunChecks.h"
 #include "render/SceneBasis.h"
@@ -80,7 +81,8 @@ nlohmann::json caseJson(const CaseInfo& c) {
           {"costs_source", c.costSource},
           {"reference", c.referenceSource},
           {"reference_variance", c.referenceVariance},
-          {"device", c.device}};
+          {"device", c.device},
+          {"node", c.node}};
 }
 
 std::string runsCsv(const Comparison& comparison) {
@@ -98,6 +100,8 @@ std::string runsCsv(const Comparison& comparison) {
   return csv;
 }
 
+}  // namespace
+
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
 void writeRuns(const std::string& outDir, const Comparison& comparison) {
   nlohmann::json json = {
@@ -107,8 +111,6 @@ void writeRuns(const std::string& outDir, const Comparison& comparison) {
   writeFileAtomically(outDir + "/runs.json", jsonText(json));
   writeFileAtomically(outDir + "/runs.csv", runsCsv(comparison));
 }
-
-}  // namespace
 
 std::string imagePath(const std::string& caseLabel, Method method, int budget) {
   return runStem(caseLabel, method, budget) + ".exr";
@@ -156,7 +158,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     double referenceVariance = 0;
     for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name()});
+                         reference->source, referenceVariance, devices.name(), nodeName()});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
