@@ -73,18 +73,6 @@ nlohmann::json runJson(const RunRecord& r) {
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel}};
 }
 
-nlohmann::json caseJson(const CaseInfo& c) {
-  return {{"label", c.label},
-          {"scene", c.scene},
-          {"techniques", c.techniques},
-          {"costs_s_per_sample", c.costs},
-          {"costs_source", c.costSource},
-          {"reference", c.referenceSource},
-          {"reference_variance", c.referenceVariance},
-          {"device", c.device},
-          {"node", c.node}};
-}
-
 std::string runsCsv(const Comparison& comparison) {
   std::string csv =
       "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,mse_corrected,"
@@ -102,11 +90,23 @@ std::string runsCsv(const Comparison& comparison) {
 
 }  // namespace
 
+nlohmann::json caseInfoJson(const CaseInfo& c) {
+  return {{"label", c.label},
+          {"scene", c.scene},
+          {"techniques", c.techniques},
+          {"costs_s_per_sample", c.costs},
+          {"costs_source", c.costSource},
+          {"reference", c.referenceSource},
+          {"reference_variance", c.referenceVariance},
+          {"device", c.device},
+          {"node", c.node}};
+}
+
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
 void writeRuns(const std::string& outDir, const Comparison& comparison) {
   nlohmann::json json = {
       {"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
-  for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseJson(c));
+  for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseInfoJson(c));
   for (const RunRecord& r : comparison.runs) json["runs"].push_back(runJson(r));
   writeFileAtomically(outDir + "/runs.json", jsonText(json));
   writeFileAtomically(outDir + "/runs.csv", runsCsv(comparison));

@@ -79,6 +79,9 @@ struct Comparison {
 // flight when `guard` reports SIGINT or SIGTERM (Comparison::interrupted).
 Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard);
 
+// A case as runs.json lists it (every figure as a double keeps it).
+nlohmann::json caseInfoJson(const CaseInfo& info);
+
 // runs.json and runs.csv: the cases and the runs so far, written atomically.
 void writeRuns(const std::string& outDir, const Comparison& comparison);
 

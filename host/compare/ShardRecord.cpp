@@ -44,24 +44,12 @@ RunRecord runRecordOf(const nlohmann::json& j) {
   return r;
 }
 
-nlohmann::json caseInfoJson(const CaseInfo& c) {
-  return {{"label", c.label},
-          {"scene", c.scene},
-          {"techniques", c.techniques},
-          {"costs", c.costs},
-          {"cost_source", c.costSource},
-          {"reference", c.referenceSource},
-          {"reference_variance", c.referenceVariance},
-          {"device", c.device},
-          {"node", c.node}};
-}
-
 CaseInfo caseInfoOf(const nlohmann::json& j) {
   return {j.at("label"),
           j.at("scene"),
           j.at("techniques").get<std::vector<std::string>>(),
-          j.at("costs").get<std::vector<double>>(),
-          j.at("cost_source"),
+          j.at("costs_s_per_sample").get<std::vector<double>>(),
+          j.at("costs_source"),
           j.at("reference"),
           j.at("reference_variance"),
           j.at("device"),
