@@ -97,6 +97,9 @@ ShardRecord readShardRecord(const std::string& folder) {
     ShardRecord r;
     r.run = j.at("run");
     r.shard = {j.at("shard").at(0), j.at("shard").at(1)};
+    if (r.shard.index < 0 || r.shard.index >= r.shard.count)
+      throw InputError(
+          fmt::format("{}: its {} names shard {}/{}", folder, kShardRecordFile, r.shard.index, r.shard.count));
     r.manifest = j.at("manifest").get<std::vector<std::string>>();
     for (const auto& m : j.at("methods")) r.methods.push_back(parseMethod(m));
     r.budgets = j.at("budgets").get<std::vector<int>>();

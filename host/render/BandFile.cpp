@@ -38,12 +38,15 @@ ReadBand readBand(const std::string& path) {
   r.node = attribute(found, kNode, path);
   const std::string shard = attribute(found, kShard, path), rows = attribute(found, kRows, path),
                     image = attribute(found, kImage, path);
+  r.report = nlohmann::json::parse(attribute(found, kReport, path), nullptr, false);
+  const Shard& k = r.band.shard;
+  const RowRange& y = r.band.rows;
   if (std::sscanf(shard.c_str(), "%d/%d", &r.band.shard.index, &r.band.shard.count) != 2 ||
       std::sscanf(rows.c_str(), "%d-%d", &r.band.rows.begin, &r.band.rows.end) != 2 ||
-      std::sscanf(image.c_str(), "%dx%d", &r.width, &r.height) != 2)
+      std::sscanf(image.c_str(), "%dx%d", &r.width, &r.height) != 2 || k.index < 0 || k.index >= k.count ||
+      y.begin < 0 || y.begin >= y.end || y.end > r.height || r.report.is_discarded())
     throw InputError(
         fmt::format("{}: its band record is malformed (shard {}, rows {}, image {})", path, shard, rows, image));
-  r.report = nlohmann::json::parse(attribute(found, kReport, path), nullptr, false);
   if (band.rows.width != r.width || band.rows.height != r.band.rows.size())
     throw InputError(fmt::format("{}: its pixels are {}x{}, not the {}x{} of rows {} of a {} image", path,
                                  band.rows.width, band.rows.height, r.width, r.band.rows.size(), rows, image));

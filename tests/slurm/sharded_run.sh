@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A sharded compare and render under a real one-node Slurm on localhost: writes its own
 # slurm.conf, starts munged, slurmctld and slurmd as root (docs/testing.md), submits
-# both with scripts/slurm/submit.sh (job arrays, then the merge after afterok), checks
+# both with scripts/slurm/submit.sh (job arrays, each with its merge after afterok), checks
 # the merged outputs against the unsharded runs, and stops the daemons it started by
 # their process ids. Exit 77 (skipped), saying why, where it cannot run.
 #   sharded_run.sh MISALLOC_BINARY SOURCE_DIR
@@ -84,8 +84,11 @@ compare="--suite --size 8x8 --methods equal,exact --budgets 16 --repeats 1 --cos
 
 "$misalloc" render $render --no-preview --out "$scratch/whole.exr" --report "$scratch/whole.json" >/dev/null
 "$misalloc" compare $compare $cache --out-dir "$scratch/whole" >/dev/null 2>&1
-bash "$source/scripts/slurm/submit.sh" render 3 2 "$out/render" --wait -- $render
-bash "$source/scripts/slurm/submit.sh" compare 2 1 "$out/compare" --wait -- $compare $cache
+# Both at once; then until the queue is empty, polled more often than sbatch --wait does.
+bash "$source/scripts/slurm/submit.sh" render 3 2 "$out/render" -- $render
+bash "$source/scripts/slurm/submit.sh" compare 2 1 "$out/compare" -- $compare $cache
+for _ in $(seq 1200); do [ -z "$(squeue -h -o %i)" ] && break; sleep 0.1; done
+[ -z "$(squeue -h -o %i)" ] || { squeue; echo "FAILED: the jobs did not finish in 2 minutes"; exit 1; }
 
 cmp "$scratch/whole.exr" "$out/render/merged.exr"
 grep -q '"node"' "$out/render/merged.json"
