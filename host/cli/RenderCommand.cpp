@@ -47,11 +47,17 @@ struct RenderArgs {
   std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
 
-// A sharded render's band (render/Band.h): what it may not be asked for, and where its
-// costs come from, checked before any work.
-std::optional<Band> requestedBand(RenderArgs& args, Method m, const AdaptiveOptions& adaptive, int height) {
-  if (args.shard.empty()) return std::nullopt;
+// A band of a sharded render writes its rows only: no preview, no α map.
+void refuseBandOutputs(RenderArgs& args) {
+  if (args.shard.empty()) return;
   if (!args.alphaMap.empty()) throw InputError("--alpha-map: a band of a sharded render (--shard) writes no alpha map");
+  args.noPreview = true;
+}
+
+// A sharded render's band (render/Band.h) and where its costs come from, checked before
+// any work.
+std::optional<Band> requestedBand(const RenderArgs& args, Method m, const AdaptiveOptions& adaptive, int height) {
+  if (args.shard.empty()) return std::nullopt;
   // Costs measured by each band on its own node would differ, and so would the bands'
   // allocations: a seam. Every band takes the same costs.
   if (methodTraits(m).adaptive() && adaptive.costs.empty())
@@ -59,7 +65,6 @@ std::optional<Band> requestedBand(RenderArgs& args, Method m, const AdaptiveOpti
         fmt::format("--shard with --method {}: give the costs with --cost (every band must allocate with "
                     "the same costs; a render's report has them as costs_s_per_sample)",
                     args.method));
-  args.noPreview = true;
   return bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(m, adaptive));
 }
 
@@ -80,15 +85,16 @@ int runRender(RenderArgs& args) {
   OutputSet outputs(inputs);
   outputs.claim("--out", args.out);
   outputs.claim("--report", args.report);
-  Scene scene = args.scene.make();
-  AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
-  requireValidRun(scene.options, m, estimator, args.spp, adaptive);
-  const std::optional<Band> band = requestedBand(args, m, adaptive, scene.grid.height);
+  refuseBandOutputs(args);
   if (!args.noPreview) outputs.claim("the preview (--no-preview skips it)", previewPath(args.out));
   if (!args.alphaMap.empty()) {
     outputs.claim("--alpha-map", args.alphaMap);
     outputs.claim("--alpha-map", alphaPngPath(args.alphaMap));
   }
+  Scene scene = args.scene.make();
+  AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
+  requireValidRun(scene.options, m, estimator, args.spp, adaptive);
+  const std::optional<Band> band = requestedBand(args, m, adaptive, scene.grid.height);
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
@@ -104,8 +110,9 @@ int runRender(RenderArgs& args) {
     checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
   }
   // A band renders its rows and those its pooling reads, with the image's random numbers.
-  const Scene renderedScene = band ? bandScene(scene, band->rendered) : scene;
-  auto sampler = args.devices.makeSampler(renderedScene, config, args.localSize);
+  std::optional<Scene> bandRows;
+  if (band) bandRows = bandScene(scene, band->rendered);
+  auto sampler = args.devices.makeSampler(band ? *bandRows : scene, config, args.localSize);
   std::string deviceName = args.devices.name();
   SceneBasis basis = findSceneBasis(
       plainScene, {args.reference == "auto", args.referenceSpp, args.cacheDir, traits.adaptive(), adaptive.costs},
@@ -118,7 +125,7 @@ int runRender(RenderArgs& args) {
     // The band's report is of its own rows, as a scene of their own.
     r = cropRendering(r, width, scene.techniqueCount(), band->rendered, band->rows);
     if (reference) reference = cropReference(*reference, band->rows);
-    scene = bandScene(scene, band->rows);
+    scene = bandScene(std::move(scene), band->rows);
   }
   nlohmann::json report = renderReport(
       {scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});

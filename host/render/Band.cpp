@@ -45,15 +45,14 @@ Band bandOf(Shard shard, int height, int haloRows) {
   return band;
 }
 
-Scene bandScene(const Scene& image, RowRange rows) {
-  Scene band = image;
+Scene bandScene(Scene image, RowRange rows) {
   const size_t width = size_t(image.grid.width);
-  band.firstPixel = image.firstPixel + int(size_t(rows.begin) * width);
-  band.grid.height = rows.size();
-  band.grid.pixels = rowsOf(image.grid.pixels, width, 0, rows);
-  band.options.height = rows.size();
-  if (image.tables.hasBank()) band.tables.brdfBinOfPixel = rowsOf(image.tables.brdfBinOfPixel, width, 0, rows);
-  return band;
+  image.firstPixel += int(size_t(rows.begin) * width);
+  image.grid.height = rows.size();
+  image.grid.pixels = rowsOf(image.grid.pixels, width, 0, rows);
+  image.options.height = rows.size();
+  if (image.tables.hasBank()) image.tables.brdfBinOfPixel = rowsOf(image.tables.brdfBinOfPixel, width, 0, rows);
+  return image;
 }
 
 Rendering cropRendering(const Rendering& rendering, int width, int techniques, RowRange rendered, RowRange rows) {

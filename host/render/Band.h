@@ -36,8 +36,9 @@ int poolingHaloRows(Method method, const AdaptiveOptions& options);
 // block rows than shards (a band would be empty).
 Band bandOf(Shard shard, int height, int haloRows);
 
-// The rows `rows` of `image` as a scene of their own, keyed on the image's pixels.
-Scene bandScene(const Scene& image, RowRange rows);
+// The rows `rows` of `image` as a scene of their own, keyed on the image's pixels. It
+// keeps the envmap's tables: pass the image by std::move where it is not needed after.
+Scene bandScene(Scene image, RowRange rows);
 
 // The rows `rows` of a render of the rows `rendered` (image rows both).
 Rendering cropRendering(const Rendering& rendering, int width, int techniques, RowRange rendered, RowRange rows);
