@@ -24,12 +24,15 @@
 enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
 
 // Everything one sample needs, re-read from global memory (cached) at each sample for
-// the same reason. Sample j of `technique`'s samples (one-sample: of the stage).
+// the same reason. Sample j of `technique`'s samples (one-sample: of the stage). The
+// random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
+// image's rows (host/render/Band.h) draws the samples the whole image's render draws.
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs, int width,
                                        int height, __global const float* brdfParams, MaVec3 mirror,
                                        __global const int* counts, __global const uint* firstIndex, int stageSamples,
-                                       uint seedLo, uint seedHi, int pixel, int technique, int j) {
+                                       uint seedLo, uint seedHi, int firstPixel, int pixel, int technique,
+                                       int j) {
   EnvmapView env;
   env.texels = texels;
   env.cdfTable = cdfTable;
@@ -59,10 +62,10 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   StageCounts c =
       loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT);
 #if MA_ONE_SAMPLE
-  return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)pixel);
+  return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)(firstPixel + pixel));
 #else
   return takeTechniqueSample(ts, env, b, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo, seedHi,
-                             (uint)pixel);
+                             (uint)(firstPixel + pixel));
 #endif
 }
 
@@ -70,7 +73,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable,
     __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
     float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
-    uint seedLo, uint seedHi, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
+    uint seedLo, uint seedHi, int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
     __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
@@ -99,7 +102,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int jk = 0; jk < passSamples; ++jk) {
       SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, width, height, brdfParams,
                                            makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
-                                           seedLo, seedHi, pixel, k, jk);
+                                           seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;

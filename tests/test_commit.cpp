@@ -9,46 +9,15 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
-#include <chrono>
-#include <thread>
 
 #include "AtomicFile.h"
 #include "CliRunner.h"
 #include "SafetyWorkspace.h"
+#include "Spawn.h"
 
 using namespace misalloc::test;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-// misalloc with `args`, its output discarded, in a process of its own.
-pid_t spawnMisalloc(const std::string& args, const std::string& environment = "") {
-  const std::string command = fmt::format("exec env {} {} {} >/dev/null 2>&1", environment, MISALLOC_BINARY, args);
-  pid_t pid = fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    execl("/bin/sh", "sh", "-c", command.c_str(), (char*)nullptr);
-    _exit(127);
-  }
-  return pid;
-}
-
-// Waits (at most a minute) until `ready` holds; false if it never did.
-template <typename Predicate>
-bool waitFor(Predicate ready) {
-  for (auto start = Clock::now(); Clock::now() - start < std::chrono::minutes(1);) {
-    if (ready()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  return false;
-}
-
-int waitStatus(pid_t pid) {
-  int status = 0;
-  REQUIRE(waitpid(pid, &status, 0) == pid);
-  return status;
-}
 
 // A PID that no process has: one that just ended.
 long deadPid() {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "AtomicFile.h"
@@ -17,12 +18,14 @@
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
 #include "cli/EnvmapInputs.h"
+#include "cli/RunIdentity.h"
 #include "cli/SceneArgs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
 #include "compare/CompareReport.h"
 #include "compare/Comparison.h"
 #include "compare/EnvmapPdfComparison.h"
+#include "compare/ShardRecord.h"
 #include "compare/Suite.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
@@ -37,7 +40,7 @@ struct CompareArgs {
   AdaptiveArgs adaptive;
   DeviceArgs devices;
   CompareOptions compare;
-  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal";
+  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal", shard;
   bool suite = false;
 };
 
@@ -85,7 +88,17 @@ int runCompare(CompareArgs& args) {
     // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
-  compare.cases = casesPerEnvmapPdf(compare.cases, parseEnvmapPdfList(args.envmapPdfs));
+  const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
+  std::optional<ShardRecord> shard;
+  if (!args.shard.empty()) {
+    // Every shard knows the whole run's cases, in order, for the merge.
+    shard.emplace();
+    shard->run = runIdentity(*args.command, {"--shard", "--out-dir", "--cache-dir", "--help"});
+    shard->shard = parseShard(args.shard, "--shard");
+    for (const CompareCase& c : casesPerEnvmapPdf(compare.cases, pdfs)) shard->manifest.push_back(c.label);
+    compare.cases = shardScenes(compare.cases, shard->shard);
+  }
+  compare.cases = casesPerEnvmapPdf(compare.cases, pdfs);
   for (CompareCase& c : compare.cases) c.scene.bankCacheDir = compare.cacheDir;
   compare.methods = parseMethodList(args.methods);
   compare.budgets = parseBudgets(args.budgets);
@@ -112,17 +125,27 @@ int runCompare(CompareArgs& args) {
   // Filled as it runs, and put in the place of the folder at the end.
   compare.outDir = outputs.claimFolder("--out-dir", outDir, "runs.json");
   Comparison comparison = runComparison(compare, guard);
-  Summary summary = summarize(comparison, compare);
-  writeCompareReport(summary, compare.outDir);
-  const std::string envmapPdfTables = envmapPdfMarkdown(summary);
-  if (!envmapPdfTables.empty()) writeFileAtomically(compare.outDir + "/envmap_pdfs.md", envmapPdfTables);
+  if (shard) {
+    // A shard's summary would compare its own scenes only: merge writes the run's.
+    shard->methods = compare.methods;
+    shard->budgets = compare.budgets;
+    shard->repeats = compare.repeats;
+    shard->tableBudget = compare.tableBudget;
+    shard->comparison = comparison;
+    writeFileAtomically(compare.outDir + "/" + kShardRecordFile, shardRecordJson(*shard));
+    outputs.commit();
+    std::cout << fmt::format("shard {}: {} case(s), {} run(s) in {}; merge the shards with misalloc merge --out-dir\n",
+                             args.shard, comparison.cases.size(), comparison.runs.size(), outDir);
+    return comparison.interrupted ? 130 : 0;
+  }
+  ComparisonReport report = writeComparisonReport(comparison, compare, compare.outDir);
   outputs.commit();
   if (comparison.interrupted) {
     std::cerr << fmt::format("misalloc: interrupted after {} runs; {} holds them, every file complete\n",
                              comparison.runs.size(), outDir);
     return 130;
   }
-  std::cout << summaryMarkdown(summary) << envmapPdfTables;
+  std::cout << summaryMarkdown(report.summary) << report.envmapPdfTables;
   std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n", outDir);
   return 0;
 }
@@ -160,6 +183,9 @@ Subcommand addCompareCommand(CLI::App& app) {
       ->check(integerIn(1, INT_MAX));
   compare.cacheDir = defaultCacheDir();
   command->add_option("--cache-dir", compare.cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
+  command->add_option("--shard", args->shard,
+                      "K/N: run shard K of N (every N-th scene with all its methods, pdfs, budgets and repeats) "
+                      "into --out-dir, for `misalloc merge --out-dir`");
   return {command, [args] { return runCompare(*args); }};
 }
 

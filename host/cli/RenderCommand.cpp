@@ -8,16 +8,19 @@
 #include <optional>
 
 #include "Error.h"
+#include "Interruption.h"
 #include "JsonText.h"
 #include "OptionRange.h"
-#include "Interruption.h"
 #include "OutputSet.h"
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
 #include "cli/EnvmapInputs.h"
+#include "cli/RunIdentity.h"
 #include "cli/SceneArgs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
+#include "render/Band.h"
+#include "render/BandFile.h"
 #include "render/Method.h"
 #include "render/Reference.h"
 #include "render/Render.h"
@@ -40,8 +43,30 @@ struct RenderArgs {
   uint64_t seed = 1;
   bool noPreview = false;
   std::string method = "exact", estimator = "multi", out = "render.exr", report = "render.json", reference = "auto",
-              cacheDir = defaultCacheDir(), alphaMap;
+              cacheDir = defaultCacheDir(), alphaMap, shard;
+  std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
+
+// A band of a sharded render writes its rows only: no preview, no α map.
+void refuseBandOutputs(RenderArgs& args) {
+  if (args.shard.empty()) return;
+  if (!args.alphaMap.empty()) throw InputError("--alpha-map: a band of a sharded render (--shard) writes no alpha map");
+  args.noPreview = true;
+}
+
+// A sharded render's band (render/Band.h) and where its costs come from, checked before
+// any work.
+std::optional<Band> requestedBand(const RenderArgs& args, Method m, const AdaptiveOptions& adaptive, int height) {
+  if (args.shard.empty()) return std::nullopt;
+  // Costs measured by each band on its own node would differ, and so would the bands'
+  // allocations: a seam. Every band takes the same costs.
+  if (methodTraits(m).adaptive() && adaptive.costs.empty())
+    throw InputError(
+        fmt::format("--shard with --method {}: give the costs with --cost (every band must allocate with "
+                    "the same costs; a render's report has them as costs_s_per_sample)",
+                    args.method));
+  return bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(m, adaptive));
+}
 
 Estimator parseEstimator(const std::string& name) {
   if (name == "multi") return Estimator::MultiSample;
@@ -60,6 +85,7 @@ int runRender(RenderArgs& args) {
   OutputSet outputs(inputs);
   outputs.claim("--out", args.out);
   outputs.claim("--report", args.report);
+  refuseBandOutputs(args);
   if (!args.noPreview) outputs.claim("the preview (--no-preview skips it)", previewPath(args.out));
   if (!args.alphaMap.empty()) {
     outputs.claim("--alpha-map", args.alphaMap);
@@ -69,6 +95,7 @@ int runRender(RenderArgs& args) {
   Scene scene = args.scene.make();
   AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
   requireValidRun(scene.options, m, estimator, args.spp, adaptive);
+  const std::optional<Band> band = requestedBand(args, m, adaptive, scene.grid.height);
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
   requireStatisticsMemory(scene.options, {m}, "--spp", args.spp, adaptive, args.devices.onHost(),
                           args.devices.samplerCount());
@@ -83,7 +110,10 @@ int runRender(RenderArgs& args) {
     reference = Reference{readExr(args.reference), {}, "file", args.reference};
     checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
   }
-  auto sampler = args.devices.makeSampler(scene, config, args.localSize);
+  // A band renders its rows and those its pooling reads, with the image's random numbers.
+  std::optional<Scene> bandRows;
+  if (band) bandRows = bandScene(scene, band->rendered);
+  auto sampler = args.devices.makeSampler(band ? *bandRows : scene, config, args.localSize);
   std::string deviceName = args.devices.name();
   SceneBasis basis = findSceneBasis(
       plainScene, {args.reference == "auto", args.referenceSpp, args.cacheDir, traits.adaptive(), adaptive.costs},
@@ -91,11 +121,26 @@ int runRender(RenderArgs& args) {
   if (basis.reference) reference = std::move(basis.reference);
   adaptive.costs = basis.costs;
   Rendering r = render(*sampler, m, adaptive, args.spp, args.seed);
-  nlohmann::json report =
-      renderReport({scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});
-  outputs.put(args.out, encodeExr(r.image));
+  const int width = scene.grid.width, height = scene.grid.height;
+  if (band) {
+    // The band's report is of its own rows, as a scene of their own.
+    r = cropRendering(r, width, scene.techniqueCount(), band->rendered, band->rows);
+    if (reference) reference = cropReference(*reference, band->rows);
+    scene = bandScene(std::move(scene), band->rows);
+  }
+  nlohmann::json report = renderReport(
+      {scene, m, config.estimator, adaptive, basis.costSource, args.spp, args.seed, deviceName, r, reference});
+  if (band) {
+    report["band"] = {{"shard", args.shard},
+                      {"rows", {band->rows.begin, band->rows.end}},
+                      {"rendered_rows", {band->rendered.begin, band->rendered.end}}};
+    outputs.put(args.out, encodeBand(r.image, {args.run, *band, width, height, nodeName(), report}));
+  } else {
+    outputs.put(args.out, encodeExr(r.image));
+  }
   if (!args.noPreview)
-    outputs.put(previewPath(args.out), encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));
+    outputs.put(previewPath(args.out),
+                encodePreviewPng(r.image, previewExposure(reference ? reference->image : r.image)));
   if (!args.alphaMap.empty()) {
     AlphaMapFiles alpha = encodeAlphaMaps(scene, r);
     outputs.put(args.alphaMap, std::move(alpha.exr));
@@ -112,9 +157,9 @@ int runRender(RenderArgs& args) {
         "RMSE x1000 {:.3f}, {:.3f} corrected for the reference's own error, relative MSE {:.4g} (reference: {})\n",
         report["rmse_x1000"].get<double>(), report["rmse_x1000_corrected"].get<double>(),
         report["relative_mse"].get<double>(), reference->source);
-  std::cout << fmt::format("wrote {}{}, {}{}\n", args.out, args.noPreview ? "" : ", " + previewPath(args.out),
-                           args.report,
-                           args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
+  std::cout << fmt::format(
+      "wrote {}{}, {}{}\n", args.out, args.noPreview ? "" : ", " + previewPath(args.out), args.report,
+      args.alphaMap.empty() ? "" : fmt::format(", {} and {}", args.alphaMap, alphaPngPath(args.alphaMap)));
   return 0;
 }
 
@@ -149,7 +194,13 @@ Subcommand addRenderCommand(CLI::App& app) {
       ->check(integerIn(1, INT_MAX));
   command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
   command->add_option("--local-size", args->localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
-  return {command, [args] { return runRender(*args); }};
+  command->add_option("--shard", args->shard,
+                      "K/N: render band K of N (whole rows of 16-pixel blocks) into --out, for `misalloc merge`");
+  return {command, [args, command] {
+            args->run = runIdentity(*command, {"--shard", "--out", "--report", "--no-preview", "--cache-dir",
+                                               "--reference", "--reference-spp", "--help"});
+            return runRender(*args);
+          }};
 }
 
 }  // namespace misalloc

@@ -18,5 +18,6 @@ Subcommand addRenderCommand(CLI::App& app);     // RenderCommand.cpp
 Subcommand addReferenceCommand(CLI::App& app);  // ReferenceCommand.cpp
 Subcommand addCompareCommand(CLI::App& app);    // CompareCommand.cpp
 Subcommand addPaperCommand(CLI::App& app);      // PaperCommand.cpp
+Subcommand addMergeCommand(CLI::App& app);      // MergeCommand.cpp
 
 }  // namespace misalloc

@@ -2,6 +2,7 @@
 
 #include "AtomicFile.h"
 #include "JsonText.h"
+#include "compare/EnvmapPdfComparison.h"
 #include "compare/ErrorTimePlot.h"
 #include "compare/HtmlIndex.h"
 #include "compare/SummaryTables.h"
@@ -16,6 +17,15 @@ void writeCompareReport(const Summary& summary, const std::string& outDir) {
   for (const SceneGroup& scene : groupByScene(summary))
     writeFileAtomically(outDir + "/" + plotFileName(scene.label), errorTimePlotSvg(scene));
   writeFileAtomically(outDir + "/index.html", indexHtml(summary));
+}
+
+ComparisonReport writeComparisonReport(const Comparison& comparison, const CompareOptions& options,
+                                       const std::string& outDir) {
+  ComparisonReport report{summarize(comparison, options), ""};
+  writeCompareReport(report.summary, outDir);
+  report.envmapPdfTables = envmapPdfMarkdown(report.summary);
+  if (!report.envmapPdfTables.empty()) writeFileAtomically(outDir + "/envmap_pdfs.md", report.envmapPdfTables);
+  return report;
 }
 
 }  // namespace misalloc

@@ -10,6 +10,7 @@
 #include "Error.h"
 #include "JsonText.h"
 #include "compare/ProgressMeter.h"
+#include "render/BandFile.h"
 #include "render/Reference.h"
 #include "render/RunChecks.h"
 #include "render/SceneBasis.h"
@@ -81,18 +82,6 @@ nlohmann::json leftOutJson(const std::vector<LeftOutMethod>& leftOut) {
   return list;
 }
 
-nlohmann::json caseJson(const CaseInfo& c) {
-  return {{"label", c.label},
-          {"scene", c.scene},
-          {"techniques", c.techniques},
-          {"costs_s_per_sample", c.costs},
-          {"costs_source", c.costSource},
-          {"reference", c.referenceSource},
-          {"reference_variance", c.referenceVariance},
-          {"device", c.device},
-          {"left_out", leftOutJson(c.leftOut)}};
-}
-
 std::string runsCsv(const Comparison& comparison) {
   std::string csv =
       "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,mse_corrected,"
@@ -108,17 +97,30 @@ std::string runsCsv(const Comparison& comparison) {
   return csv;
 }
 
+}  // namespace
+
+nlohmann::json caseInfoJson(const CaseInfo& c) {
+  return {{"label", c.label},
+          {"scene", c.scene},
+          {"techniques", c.techniques},
+          {"costs_s_per_sample", c.costs},
+          {"costs_source", c.costSource},
+          {"reference", c.referenceSource},
+          {"reference_variance", c.referenceVariance},
+          {"device", c.device},
+          {"node", c.node},
+          {"left_out", leftOutJson(c.leftOut)}};
+}
+
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
 void writeRuns(const std::string& outDir, const Comparison& comparison) {
   nlohmann::json json = {
       {"interrupted", comparison.interrupted}, {"cases", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
-  for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseJson(c));
+  for (const CaseInfo& c : comparison.cases) json["cases"].push_back(caseInfoJson(c));
   for (const RunRecord& r : comparison.runs) json["runs"].push_back(runJson(r));
   writeFileAtomically(outDir + "/runs.json", jsonText(json));
   writeFileAtomically(outDir + "/runs.csv", runsCsv(comparison));
 }
-
-}  // namespace
 
 std::string imagePath(const std::string& caseLabel, Method method, int budget) {
   return runStem(caseLabel, method, budget) + ".exr";
@@ -177,7 +179,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     double referenceVariance = 0;
     for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name(), c.leftOut});
+                         reference->source, referenceVariance, devices.name(), nodeName(), c.leftOut});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);

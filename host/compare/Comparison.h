@@ -76,6 +76,7 @@ struct CaseInfo {
   double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;
   std::vector<LeftOutMethod> leftOut;
+  std::string node;  // the host its runs ran on: timings compare only within one node
 };
 
 struct Comparison {
@@ -89,6 +90,12 @@ struct Comparison {
 // outDir/runs.{json,csv} after each one, all atomically. Stops after the render in
 // flight when `guard` reports SIGINT or SIGTERM (Comparison::interrupted).
 Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard);
+
+// A case as runs.json lists it (every figure as a double keeps it).
+nlohmann::json caseInfoJson(const CaseInfo& info);
+
+// runs.json and runs.csv: the cases and the runs so far, written atomically.
+void writeRuns(const std::string& outDir, const Comparison& comparison);
 
 // Throws InputError for a budget that some adaptive method cannot split into a pilot
 // and its stages, and for an empty or unknown list.

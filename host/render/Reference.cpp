@@ -11,6 +11,7 @@
 
 #include "AtomicFile.h"
 #include "Error.h"
+#include "FileLock.h"
 #include "render/Method.h"
 
 namespace misalloc {
@@ -133,6 +134,11 @@ std::string cacheEntryPath(const std::string& key, const std::string& cacheDir) 
   return (fs::path(cacheDir) / "references" / (key + ".exr")).string();
 }
 
+// Beside the entries, not among them: a folder of entries holds entries only.
+std::string cacheLockPath(const std::string& key, const std::string& cacheDir) {
+  return (fs::path(cacheDir) / "locks" / (key + ".lock")).string();
+}
+
 // The cache entry's channels: the image, then the standard deviation of its error.
 const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_error.G", "standard_error.B"};
 
@@ -206,26 +212,53 @@ std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const
   return cacheEntryPath(referenceKey(scene, spp), cacheDir);
 }
 
+namespace {
+
+// The cache entry at `path` if it can be trusted; else why not, in `problem` (empty
+// when there is no entry).
+std::optional<Reference> trustedEntry(const std::string& path, const std::string& key, const Scene& scene, int spp,
+                                      const std::string& source, std::string& problem) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return std::nullopt;
+  CacheEntry entry = readCacheEntry(path, key, scene, spp);
+  if (entry.reference)
+    return Reference{std::move(entry.reference->image), std::move(entry.reference->standardError), source + " (cached)",
+                     path};
+  problem = entry.problem;
+  return std::nullopt;
+}
+
+}  // namespace
+
 Reference findReference(const Scene& scene, int spp, const std::string& cacheDir, const SamplerFactory& makeSampler) {
   if (auto analytic = analyticReference(scene)) return Reference{*analytic, {}, "analytic ([HS14] eq. 6.17)", ""};
   // The key hashes every texel: computed once for the path and the claims.
   const std::string key = referenceKey(scene, spp), path = cacheEntryPath(key, cacheDir);
   const std::string source = fmt::format("{}, {} spp", referenceEstimator(scene.options), spp);
-  std::string recomputed;
-  std::error_code ec;
-  if (fs::exists(path, ec)) {
-    CacheEntry entry = readCacheEntry(path, key, scene, spp);
-    if (entry.reference)
-      return Reference{std::move(entry.reference->image), std::move(entry.reference->standardError),
-                       source + " (cached)", path};
-    std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; computing it again\n",
-                             path, entry.problem);
-    recomputed = fmt::format(" (computed again: the cached entry was not trusted: {})", entry.problem);
+  std::string problem;
+  if (auto cached = trustedEntry(path, key, scene, spp, source, problem)) return std::move(*cached);
+  const std::string lockPath = cacheLockPath(key, cacheDir);
+  for (const fs::path& folder : {fs::path(path).parent_path(), fs::path(lockPath).parent_path()}) {
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (ec)
+      throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, folder.string(), ec.message()));
   }
-  fs::create_directories(fs::path(path).parent_path(), ec);
-  if (ec)
-    throw InputError(fmt::format("--cache-dir {}: cannot create {}: {}", cacheDir, fs::path(path).parent_path().string(),
-                                 ec.message()));
+  // Shards of one scene may share the cache (a shared file system): one computes the
+  // entry under the lock, the others wait and read it, so no reference is computed
+  // twice at once; the entry itself is written beside and renamed into place, so no
+  // reader ever sees half of one.
+  FileLock lock(lockPath, [&] {
+    std::cerr << fmt::format("misalloc: another process is computing the reference {}; waiting for it\n", path)
+              << std::flush;
+  });
+  if (auto cached = trustedEntry(path, key, scene, spp, source, problem)) return std::move(*cached);
+  std::string recomputed;
+  if (!problem.empty()) {
+    std::cerr << fmt::format("misalloc: warning: the cached reference {} is not trusted: {}; computing it again\n",
+                             path, problem);
+    recomputed = fmt::format(" (computed again: the cached entry was not trusted: {})", problem);
+  }
   std::cerr << fmt::format("misalloc: computing the reference ({}, {} spp, {}x{} pixels) once; it is cached in {}\n",
                            referenceEstimator(scene.options), spp, scene.grid.width, scene.grid.height,
                            fs::path(path).parent_path().string());

@@ -69,7 +69,10 @@ std::optional<std::string> referenceCachePath(const Scene& scene, int spp, const
 // entry carries in its header what it claims to be (the scene's key, the estimator,
 // spp, size) and a checksum of its pixels; one that cannot be read, or whose claims or
 // checksum do not match, is never trusted: it is reported on stderr and in the source,
-// and computed again. Progress of a computation goes to stderr.
+// and computed again. Progress of a computation goes to stderr. Processes that share the
+// cache (shards on a shared file system) compute an entry one at a time, under a lock
+// (CACHE_DIR/locks/KEY.lock beside CACHE_DIR/references/KEY.exr, FileLock.h): the others
+// wait and then read the entry.
 using SamplerFactory = std::function<std::unique_ptr<StageSampler>(const Scene&)>;
 Reference findReference(const Scene& scene, int spp, const std::string& cacheDir, const SamplerFactory& makeSampler);
 

@@ -68,8 +68,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {
-      kern::SampleContribution s =
-          kern::takeStageSample(ts, pixelEnv, b, c, j, uint32_t(seed), uint32_t(seed >> 32), uint32_t(pixel));
+      kern::SampleContribution s = kern::takeStageSample(ts, pixelEnv, b, c, j, uint32_t(seed), uint32_t(seed >> 32),
+                                                         uint32_t(scene_.firstPixel + pixel));
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)
         if (s.technique == slot / perTechnique)

@@ -129,8 +129,8 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   bindKernelArgs(kernel, b.texels, b.cdfTable, b.aliasTable, b.blockProbs, cl_int(scene_.tables.width),
                  cl_int(scene_.tables.height), b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2],
                  counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
-                 cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
-                 cl_int(config_.sampleCapacity));
+                 cl_int(scene_.firstPixel), cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
+                 cl_int(firstSlot), cl_int(config_.sampleCapacity));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);

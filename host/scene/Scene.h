@@ -36,6 +36,10 @@ struct Scene {
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
   std::string bankCacheKey;     // where the optimal pdf's tables were looked up in SceneOptions::bankCacheDir
+  // The image's index of pixel 0: 0 for a whole image; a band of an image's rows
+  // (render/Band.h) keys its random numbers on the image's pixels, so that it draws
+  // exactly the samples the whole image's render draws there.
+  int firstPixel = 0;
 
   int techniqueCount() const { return options.techniqueCount(); }
   int pixelCount() const { return grid.width * grid.height; }

@@ -1,0 +1,26 @@
+#pragma once
+// The shards of a comparison (compare --shard K/N) joined into the comparison the
+// unsharded run makes: its cases and runs in the unsharded order, and every file the
+// shards wrote.
+#include <string>
+#include <vector>
+
+#include "compare/Comparison.h"
+
+namespace misalloc {
+
+struct MergedComparison {
+  CompareOptions options;  // what the summary reads: methods, budgets, repeats, the table's budget
+  Comparison comparison;
+};
+
+// Throws InputError, naming the folder, for a folder that is not a shard, shards of
+// different runs (options or versions), a shard given twice or missing, and an
+// interrupted shard.
+MergedComparison mergeShards(const std::vector<std::string>& folders);
+
+// Copies what the shard in `folder` wrote of its cases (images, α maps, previews) into
+// `outDir`; its record and its runs files, which the merge writes whole, are left out.
+void copyShardFiles(const std::string& folder, const std::string& outDir);
+
+}  // namespace misalloc

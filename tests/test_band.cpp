@@ -1,0 +1,106 @@
+// A sharded render: bands of whole 16-pixel-block rows merged into the unsharded
+// image bit for bit, for every method (exact's pooling over several stages included),
+// and merge's refusals of bands that do not make one run's image.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <string>
+#include <vector>
+
+#include "CliRunner.h"
+#include "SafetyWorkspace.h"
+#include "TestSize.h"
+#include "render/Band.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+// A 16×40 image: three bands of 16, 16 and 8 rows; given costs, as a sharded render needs.
+std::string renderArgs(const fs::path& dir, const std::string& method, const std::string& extra) {
+  return fmt::format(
+      "render --envmap sun --size 16x40 --spp 48 --method {} --cost 1,1.5 --device cpu --reference none --no-preview "
+      "--report {} {}",
+      method, (dir / "report.json").string(), extra);
+}
+
+std::string bandPath(const fs::path& dir, int k) { return (dir / fmt::format("band{}.exr", k)).string(); }
+
+// Renders bands `ks` of `bands` of `method` with `extra`, each in a process of its own.
+void renderBands(const fs::path& dir, const std::string& method, const std::string& extra, int bands,
+                 const std::vector<int>& ks) {
+  for (int k : ks) {
+    auto r = runMisalloc(
+        renderArgs(dir, method, fmt::format("{} --shard {}/{} --out {}", extra, k, bands, bandPath(dir, k))));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("bands of whole block rows, their halo, and the shard option", "[band]") {
+  Band b = bandOf({1, 3}, 40, 4);
+  CHECK((b.rows.begin == 16 && b.rows.end == 32 && b.rendered.begin == 12 && b.rendered.end == 36));
+  b = bandOf({2, 3}, 40, 4);
+  CHECK((b.rows.begin == 32 && b.rows.end == 40 && b.rendered.begin == 28 && b.rendered.end == 40));
+  CHECK_THROWS_AS(bandOf({3, 4}, 40, 0), InputError);  // three block rows for four bands
+  CHECK(parseShard("2/5", "--shard").index == 2);
+  for (const char* bad : {"5/5", "-1/2", "1", "a/2", "1/0", "1/2/3", ""})
+    CHECK_THROWS_AS(parseShard(bad, "--shard"), InputError);
+}
+
+TEST_CASE("merged bands are the unsharded render bit for bit, for every method", "[band][cli]") {
+  TempDir dir("band");
+  std::vector<std::string> variants{
+      "equal", "envmap", "brdf", "heuristic", "sigma-sqrt-c", "linear", "oracle", "exact", "exact --stages 3 --pool 3"};
+  // Under the sanitizers: a fixed split and the widest halo, the same code paths.
+  if (smallTestSize()) variants = {"equal", "exact --stages 3 --pool 3"};
+  for (const std::string& variant : variants) {
+    const std::string method = variant.substr(0, variant.find(' '));
+    const std::string extra = variant.size() > method.size() ? variant.substr(method.size()) : "";
+    INFO(variant);
+    auto whole = runMisalloc(renderArgs(dir.path, method, extra + " --out " + (dir.path / "whole.exr").string()));
+    INFO(whole.output);
+    REQUIRE(whole.exitCode == 0);
+    renderBands(dir.path, method, extra, 3, {0, 1, 2});
+    auto merged = runMisalloc(fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "merged.exr").string(),
+                                          (dir.path / "merged.json").string(), bandPath(dir.path, 2),
+                                          bandPath(dir.path, 0), bandPath(dir.path, 1)));
+    INFO(merged.output);
+    REQUIRE(merged.exitCode == 0);
+    CHECK(readText(dir.path / "merged.exr") == readText(dir.path / "whole.exr"));
+    const std::string report = readText(dir.path / "merged.json");
+    CHECK(report.find("\"node\"") != std::string::npos);
+    if (method != "equal" && method != "envmap" && method != "brdf")  // the allocating methods' costs
+      CHECK(report.find("\"costs_source\": \"--cost\"") != std::string::npos);
+  }
+}
+
+TEST_CASE("merge refuses bands that do not make one run's image, and writes nothing", "[band][cli][safety]") {
+  TempDir dir("band_refusals");
+  renderBands(dir.path, "exact", "", 3, {0, 1, 2});
+  const std::string other = (dir.path / "other").string();
+  fs::create_directories(other);
+  fs::create_directories(dir.path / "sub");
+  renderBands(other, "exact", "--seed 2", 3, {2});     // another run
+  renderBands(dir.path / "sub", "exact", "", 2, {1});  // another split of the same run
+  const std::string b0 = bandPath(dir.path, 0), b1 = bandPath(dir.path, 1), b2 = bandPath(dir.path, 2);
+  writeExr((dir.path / "plain.exr").string(), RgbImage{16, 8, std::vector<float>(16 * 8 * 3, 1.0f)});
+  const std::string merge =
+      fmt::format("merge --out {} --report {} ", (dir.path / "m.exr").string(), (dir.path / "m.json").string());
+  checkRefusals(
+      dir.path,
+      {{merge + b0 + " " + b1 + " " + bandPath(other, 2), "bands of different runs"},
+       {merge + b0 + " " + b1, "rows 32 to 40 are missing"},
+       {merge + b0 + " " + b2, "is missing"},
+       {merge + b0 + " " + b1 + " " + b1 + " " + b2, "are the same band"},
+       {merge + b0 + " " + b1 + " " + b2 + " " + bandPath(dir.path / "sub", 1), "different images or shard counts"},
+       {merge + b0 + " " + b1 + " " + (dir.path / "plain.exr").string(), "not a band of a sharded render"},
+       {merge + b0 + " " + b1 + " " + b2 + " --out " + b1, "--out"},
+       {renderArgs(dir.path, "exact", "--shard 3/3 --out x.exr"), "--shard '3/3'"},
+       {"render --envmap sun --size 16x40 --spp 48 --method exact --device cpu --reference none --shard 0/3", "--cost"},
+       {renderArgs(dir.path, "equal", "--shard 0/4 --out x.exr"), "fewer than the 4 bands"}},
+      dir.path / "m.exr");
+}
