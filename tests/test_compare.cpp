@@ -75,7 +75,7 @@ TEST_CASE("the speed-up over equal at equal error is the ratio of efficiencies u
   CHECK(noisy.secondsFor(1.5).value < 2);
 }
 
-TEST_CASE("repeats reduce to means and spreads; unfinished budgets are left out", "[compare]") {
+TEST_CASE("repeats reduce to means and spreads, and unfinished budgets are left out", "[compare]") {
   Comparison c;
   c.cases.push_back({"a", {}, {"envmap", "brdf"}, {1, 1}, "--cost", "analytic", 0, "test"});
   for (int budget : {10, 20}) {

@@ -15,7 +15,7 @@
 using namespace misalloc;
 using namespace misalloc::test;
 
-TEST_CASE("the reference-corrected error agrees with the error against the exact image; the raw one does not",
+TEST_CASE("the reference-corrected error agrees with the error against the exact image, and the raw one does not",
           "[reference][corrected]") {
   for (double K : {1.0, 3.0}) {
     const Scene scene = smallScene(fmt::format("cosk:{}", K), "seed000", 64, 64);

@@ -120,7 +120,7 @@ TEST_CASE("[HS14] App. C, first block (s2 = 8.764 as printed)", "[paper]") {
   checkVector(atEqual.techniqueSecondMoment, {143.5134654, 162.0052842, 112.2668235}, 1e-9);  // "E_j at equal alpha"
 }
 
-TEST_CASE("[HS14] App. C: the printed grid minimum is a negative 'mixture'; valid ones are searched", "[paper]") {
+TEST_CASE("[HS14] App. C: the printed grid minimum is a negative 'mixture', and valid ones are searched", "[paper]") {
   Example1D c = example000AppendixC(AppendixCNormalisation::AsPrinted);
   // "grid minimum (step 0.01)": the published 23.247 sits at (0, 0.95, 0.05), where
   // p_α < 0 on (0, ~0.09) and f ≠ 0 there: a pole, no number.

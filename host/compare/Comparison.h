@@ -75,8 +75,8 @@ struct CaseInfo {
   std::string referenceSource;
   double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;
-  std::vector<LeftOutMethod> leftOut;
   std::string node;  // the host its runs ran on: timings compare only within one node
+  std::vector<LeftOutMethod> leftOut;
 };
 
 struct Comparison {

@@ -83,9 +83,10 @@ struct Progress {
 };
 
 // Runs one stage with the given counts; the caller adds it to the estimate.
-// `keepStatistics` false for the last stage, which no allocation reads. With a cost
-// model, the stage's kernel time is predicted before it runs, and the model then
-// learns from the time it took.
+// `keepStatistics` false for the last stage, which no allocation reads. With a
+// calibrated cost model, the stage's kernel time is predicted before it runs, and the
+// model then learns from the time it took; given costs (--cost) predict no seconds:
+// only their ratios are known to mean anything.
 TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples,
                      uint64_t seed, bool keepStatistics, CostModel* costs) {
   TakenStage stage;
@@ -98,14 +99,15 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
   StageTiming timing;
   timing.samples = stageSamples;
   timing.keptStatistics = keepStatistics;
+  const bool predicts = costs && !costs->isGiven();
   LaunchWork work;
-  if (costs) {
+  if (predicts) {
     work = sampler.launchWork(stage.plan);
     timing.predictedKernelSeconds = costs->predict(work);
   }
   stage.result = sampler.run(stage.plan, seed);
   timing.kernelSeconds = stage.result.kernelSeconds;
-  if (costs) costs->observe(work, stage.result.kernelSeconds);
+  if (predicts) costs->observe(work, stage.result.kernelSeconds);
   progress.timings.push_back(timing);
   for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += stage.plan.counts[i];
   progress.samplesBefore += stageSamples;
