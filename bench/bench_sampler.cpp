@@ -3,7 +3,12 @@
 // peer (HostSampler: the same estimator compiled by g++ -O3 -march=native).
 //
 //   build/bench/misalloc_bench [--device cpu] [--size 256] [--spp 64] [--summary FILE.json]
+//                              [--envmap forest_slope] [--procedural-width 512]
 //                              [google benchmark flags]
+//
+// A procedural map a few texels wide (`--envmap constant --procedural-width 16`) keeps
+// every table in L1: the kernels' rate without the cost of their table reads, the
+// arithmetic side of docs/results.md's roofline.
 //
 // Ends with a Markdown table of medians and the OpenCL/OpenMP ratio.
 #include <benchmark/benchmark.h>
@@ -23,8 +28,8 @@ using namespace misalloc;
 namespace {
 
 struct Config {
-  std::string device = "cpu";
-  int size = 256, spp = 64;
+  std::string device = "cpu", envmap = "forest_slope";
+  int size = 256, spp = 64, proceduralWidth = 512;
 } config;
 
 struct Variant {
@@ -45,6 +50,8 @@ Scene benchScene(EnvmapSampler sampler) {
   SceneOptions o;
   o.width = o.height = config.size;
   o.sampler = sampler;
+  o.envmap = config.envmap;
+  o.proceduralWidth = config.proceduralWidth;
   return makeScene(o);
 }
 
@@ -76,10 +83,13 @@ void benchOpenMp(benchmark::State& state, const Variant& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<char*> rest = bench::takeFlags(argc, argv,
-                                             {{"--device", [](const char* v) { config.device = v; }},
-                                              {"--size", [](const char* v) { config.size = std::stoi(v); }},
-                                              {"--spp", [](const char* v) { config.spp = std::stoi(v); }}});
+  std::vector<char*> rest =
+      bench::takeFlags(argc, argv,
+                       {{"--device", [](const char* v) { config.device = v; }},
+                        {"--size", [](const char* v) { config.size = std::stoi(v); }},
+                        {"--spp", [](const char* v) { config.spp = std::stoi(v); }},
+                        {"--envmap", [](const char* v) { config.envmap = v; }},
+                        {"--procedural-width", [](const char* v) { config.proceduralWidth = std::stoi(v); }}});
   bench::initialize(rest);
   std::vector<std::string> names;
   for (const Variant& v : kVariants) {
@@ -89,11 +99,15 @@ int main(int argc, char** argv) {
   }
   bench::MedianCollector reporter("samples/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  bench::PeerTable table{
-      fmt::format("Sampling, {}x{} pixels, {} spp, OpenCL device: {}", config.size, config.size, config.spp,
-                  device().name()),
-      "technique",
-      "Msample/s",
-      {{"device", device().name()}, {"width", config.size}, {"height", config.size}, {"spp", config.spp}}};
+  bench::PeerTable table{fmt::format("Sampling, {}x{} pixels, {} spp, envmap {}, OpenCL device: {}", config.size,
+                                     config.size, config.spp, config.envmap, device().name()),
+                         "technique",
+                         "Msample/s",
+                         {{"device", device().name()},
+                          {"width", config.size},
+                          {"height", config.size},
+                          {"spp", config.spp},
+                          {"envmap", config.envmap},
+                          {"procedural_width", config.proceduralWidth}}};
   bench::finish({table.addMedians(reporter, names, 1e6)});
 }

@@ -21,6 +21,8 @@
 #define ma_as_uint(f) as_uint(f)
 typedef uint ma_uint;
 typedef ulong ma_ulong;
+// The 64 bits at 8-byte slot i of a buffer of 32-bit words (the first word low).
+#define ma_load64(p, i) (((MA_GLOBAL const ma_ulong*)(p))[i])
 // Loops left in the sample loop make PoCL split it at implicit barriers: unroll them.
 #define MA_UNROLL _Pragma("unroll")
 #if defined(cl_khr_fp64)
@@ -56,6 +58,11 @@ MA_FN ma_uint ma_as_uint(float f) {
   std::memcpy(&u, &f, 4);
   return u;
 }
+MA_FN ma_ulong ma_load64(const void* p, int i) {
+  ma_ulong v;
+  std::memcpy(&v, static_cast<const char*>(p) + 8 * size_t(i), 8);
+  return v;
+}
 #endif
 
 // The most techniques the kernels handle, one place for both. The sampling kernel
@@ -75,6 +82,12 @@ MA_FN ma_uint ma_as_uint(float f) {
 // The high word of a 32×32-bit product, through a 64-bit multiply that vectorises
 // (OpenCL's mul_hi is an opaque call on PoCL).
 MA_FN ma_uint mulHi(ma_uint a, ma_uint b) { return (ma_uint)(((ma_ulong)a * (ma_ulong)b) >> 32); }
+
+// Low and high 32-bit words of a 64-bit read (ma_load64). Two words read as one halve
+// the gathers of a table lookup; on PoCL's haswell target, which has no gather
+// instruction, each gather is one scalar load per lane (docs/pocl.md).
+MA_FN ma_uint lowWord(ma_ulong v) { return (ma_uint)v; }
+MA_FN ma_uint highWord(ma_ulong v) { return (ma_uint)(v >> 32); }
 
 typedef struct {
   float x, y, z;

@@ -57,11 +57,22 @@ MA_FN int texelOfDirection(EnvmapView env, MaVec3 w) {
   return row * env.width + col;
 }
 
+// ⌊i / n⌋ for 0 ≤ i < 2^30 and 1 ≤ n < 2^24 with i/n < 2^22, exact: the float quotient
+// is within one of it (three roundings of 2^-24 each), and one step each way corrects it.
+// x86 has no vector integer division: LLVM scalarises it, one division per lane, inside
+// the vectorised sample loop (docs/pocl.md, "How misalloc's kernels apply them").
+MA_FN int rowOfIndex(int i, int n) {
+  int q = (int)((float)i / (float)n);
+  q -= q * n > i ? 1 : 0;
+  q += (q + 1) * n <= i ? 1 : 0;
+  return q;
+}
+
 MA_FN int blocksAcross(EnvmapView env) { return (env.width + (1 << env.blockLog2) - 1) >> env.blockLog2; }
 MA_FN int blocksDown(EnvmapView env) { return (env.height + (1 << env.blockLog2) - 1) >> env.blockLog2; }
 
 MA_FN int blockOfTexel(EnvmapView env, int t) {
-  int row = t / env.width;
+  int row = rowOfIndex(t, env.width);
   int col = t - row * env.width;
   return (row >> env.blockLog2) * blocksAcross(env) + (col >> env.blockLog2);
 }
@@ -74,11 +85,15 @@ MA_FN int bankEntryOf(EnvmapView env, float envmapFraction) {
   return env.brdfBin * env.bankShares + share;
 }
 
+// The bank's factor of texel t's probability: the probability of drawing its block.
+MA_FN float blockProbability(EnvmapView env, int t) {
+  return env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + blockOfTexel(env, t)];
+}
+
 // The probability that envmap sampling draws texel t.
 MA_FN float texelProbability(EnvmapView env, int t) {
   float p = env.texels[4 * t + 3];
-  if (env.bankShares > 0)
-    p *= env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + blockOfTexel(env, t)];
+  if (env.bankShares > 0) p *= blockProbability(env, t);
   return p;
 }
 
@@ -88,17 +103,20 @@ MA_FN float envmapPdfOfTexel(EnvmapView env, float texelProbability, float sinTh
   return texelProbability * (float)env.width * (float)env.height / (2.0f * MA_PI * MA_PI * ma_max(sinTheta, 1e-7f));
 }
 
-// Radiance and pdf at ω inside texel t.
+// Radiance and pdf at ω inside texel t: the texel's four words as two 64-bit reads.
 MA_FN EnvmapHit envmapTexelHit(EnvmapView env, int t, MaVec3 w) {
+  ma_ulong rg = ma_load64(env.texels, 2 * t), bp = ma_load64(env.texels, 2 * t + 1);
   EnvmapHit hit;
   if (env.coskExponent >= 0.0f) {
     hit.r = hit.g = hit.b = w.z > 0.0f ? fastPow(w.z, env.coskExponent) : 0.0f;
   } else {
-    hit.r = env.texels[4 * t + 0];
-    hit.g = env.texels[4 * t + 1];
-    hit.b = env.texels[4 * t + 2];
+    hit.r = ma_as_float(lowWord(rg));
+    hit.g = ma_as_float(highWord(rg));
+    hit.b = ma_as_float(lowWord(bp));
   }
-  hit.pdf = envmapPdfOfTexel(env, texelProbability(env, t), ma_sqrt(w.x * w.x + w.y * w.y));
+  float p = ma_as_float(highWord(bp));
+  if (env.bankShares > 0) p *= blockProbability(env, t);
+  hit.pdf = envmapPdfOfTexel(env, p, ma_sqrt(w.x * w.x + w.y * w.y));
   return hit;
 }
 
@@ -108,8 +126,8 @@ MA_FN EnvmapHit envmapLookup(EnvmapView env, MaVec3 w) { return envmapTexelHit(e
 // independent uniform: one 24-bit uniform for both is biased for large tables.
 MA_FN int sampleAliasTable(MA_GLOBAL const ma_uint* table, ma_uint buckets, ma_uint bucketBits, float coin) {
   ma_uint bucket = mulHi(bucketBits, buckets);
-  float accept = ma_as_float(table[2 * bucket]);
-  return coin < accept ? (int)bucket : (int)table[2 * bucket + 1];
+  ma_ulong entry = ma_load64(table, (int)bucket);  // acceptance bits, alias
+  return coin < ma_as_float(lowWord(entry)) ? (int)bucket : (int)highWord(entry);
 }
 
 // The last index i in [0, n) with cdf[i] ≤ u, cdf[0] = 0 ≤ u < 1 = cdf[n]: a
@@ -141,7 +159,7 @@ typedef struct {
 
 // A direction in texel t, at the jitter's place in its (u, v) square.
 MA_FN EnvmapSample envmapSampleIn(EnvmapView env, int t, float jitterU, float jitterV) {
-  int row = t / env.width;
+  int row = rowOfIndex(t, env.width);
   int col = t - row * env.width;
   float u = ((float)col + jitterU) / (float)env.width;
   float v = ((float)row + jitterV) / (float)env.height;
@@ -163,9 +181,9 @@ MA_FN EnvmapSample sampleEnvmapBank(EnvmapView env, MaRandom4 rnd) {
                                             (ma_uint)blocks, rnd.v[0], uniformFloat(rnd.v[1]));
   MA_GLOBAL const ma_uint* slots = env.aliasTable + 2 * (block << slotBits);
   int slot = (int)(rnd.v[2] >> (32 - slotBits));
-  float accept = ma_as_float(slots[2 * slot]);
-  slot = uniformFloat(rnd.v[2] << slotBits) < accept ? slot : (int)slots[2 * slot + 1];
-  int blockRow = block / across;
+  ma_ulong entry = ma_load64(slots, slot);  // acceptance bits, alias
+  slot = uniformFloat(rnd.v[2] << slotBits) < ma_as_float(lowWord(entry)) ? slot : (int)highWord(entry);
+  int blockRow = rowOfIndex(block, across);
   int row = (blockRow << env.blockLog2) + (slot >> env.blockLog2);
   int col = ((block - blockRow * across) << env.blockLog2) + (slot & ((1 << env.blockLog2) - 1));
   return envmapSampleIn(env, row * env.width + col, (float)(rnd.v[3] >> 16) * (1.0f / 65536.0f),

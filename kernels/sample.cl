@@ -23,16 +23,36 @@
 // pack into short vectors, which would stop it vectorising across work-items.
 enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
 
-// Everything one sample needs, re-read from global memory (cached) at each sample for
-// the same reason. Sample j of `technique`'s samples (one-sample: of the stage). The
-// random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
+// What a pixel's samples share, read from global memory once, before the sample loop,
+// into one row of local memory per value, as the sums: the loop keeps nothing across its
+// barrier, and reads local memory at the work-item's index instead of global memory at
+// the pixel's. PoCL's haswell target has no gather instruction, so each read at the
+// pixel's index was one scalar load per lane (docs/pocl.md, "How misalloc's kernels
+// apply them").
+enum {
+  ROW_RHO_D,
+  ROW_RHO_S,
+  ROW_N,
+  ROW_BRDF_BIN,
+  ROW_N0,
+  ROW_N1,
+  ROW_N2,
+  ROW_FIRST0,
+  ROW_FIRST1,
+  ROW_FIRST2,
+  ROW_COUNT
+};
+
+// Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
+// The envmap tables are read where the sample falls: they are the gathers that remain.
+// The random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
 // image's rows (host/render/Band.h) draws the samples the whole image's render draws.
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs, int width,
-                                       int height, __global const float* brdfParams, MaVec3 mirror,
-                                       __global const int* counts, __global const uint* firstIndex, int stageSamples,
-                                       uint seedLo, uint seedHi, int firstPixel, int pixel, int technique,
-                                       int j) {
+                                       int height, __local const int* pixelRows, int lid, MaVec3 mirror,
+                                       int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
+                                       int technique, int j) {
+#define PIXEL_ROW(row) pixelRows[(row)*MA_LOCAL_SIZE + lid]
   EnvmapView env;
   env.texels = texels;
   env.cdfTable = cdfTable;
@@ -46,7 +66,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.bankShares = MA_BANK_SHARES;
   env.blockLog2 = MA_BANK_BLOCK_LOG2;
   env.blockProbs = blockProbs;
-  env.brdfBin = (int)brdfParams[4 * pixel + 3];
+  env.brdfBin = (int)as_float(PIXEL_ROW(ROW_BRDF_BIN));
   env.bankEntry = 0;
 
   TechniqueSet ts;
@@ -55,12 +75,22 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   ts.mirror = mirror;
 
   PhongParams b;
-  b.rhoD = brdfParams[4 * pixel + 0];
-  b.rhoS = brdfParams[4 * pixel + 1];
-  b.n = brdfParams[4 * pixel + 2];
+  b.rhoD = as_float(PIXEL_ROW(ROW_RHO_D));
+  b.rhoS = as_float(PIXEL_ROW(ROW_RHO_S));
+  b.n = as_float(PIXEL_ROW(ROW_N));
 
-  StageCounts c =
-      loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT);
+  StageCounts c;
+  c.techniqueCount = MA_TECHNIQUES;
+  c.stageSamples = stageSamples;
+  c.oneSample = MA_ONE_SAMPLE;
+  c.countIndependent = MA_COUNT_INDEPENDENT;
+  c.n0 = PIXEL_ROW(ROW_N0);
+  c.n1 = PIXEL_ROW(ROW_N1);
+  c.n2 = PIXEL_ROW(ROW_N2);
+  c.first0 = (uint)PIXEL_ROW(ROW_FIRST0);
+  c.first1 = (uint)PIXEL_ROW(ROW_FIRST1);
+  c.first2 = (uint)PIXEL_ROW(ROW_FIRST2);
+#undef PIXEL_ROW
 #if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)(firstPixel + pixel));
 #else
@@ -84,6 +114,21 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
+  __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
+  StageCounts pixelCounts =
+      loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT);
+  int rowValues[ROW_COUNT] = {as_int(brdfParams[4 * pixel + 0]),
+                              as_int(brdfParams[4 * pixel + 1]),
+                              as_int(brdfParams[4 * pixel + 2]),
+                              as_int(brdfParams[4 * pixel + 3]),
+                              pixelCounts.n0,
+                              pixelCounts.n1,
+                              pixelCounts.n2,
+                              (int)pixelCounts.first0,
+                              (int)pixelCounts.first1,
+                              (int)pixelCounts.first2};
+  MA_UNROLL
+  for (int r = 0; r < ROW_COUNT; ++r) pixelRows[r * MA_LOCAL_SIZE + lid] = rowValues[r];
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
   // sampler only. A work-group runs its largest n_k; the other work-items' surplus
@@ -100,9 +145,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
-      SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, width, height, brdfParams,
-                                           makeVec3(mirrorX, mirrorY, mirrorZ), counts, firstIndex, stageSamples,
-                                           seedLo, seedHi, firstPixel, pixel, k, jk);
+      SampleContribution c =
+          sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, width, height, pixelRows, lid,
+                        makeVec3(mirrorX, mirrorY, mirrorZ), stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;

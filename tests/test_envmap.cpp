@@ -159,6 +159,18 @@ double totalVariation(const std::vector<double>& p, const std::vector<double>& q
 
 }  // namespace
 
+TEST_CASE("kern::rowOfIndex is the integer quotient over the sizes the tables allow", "[envmap]") {
+  // Every side up to 2^22 - 1 and every index below 2^29 (buildEnvmapTables refuses more):
+  // the rows next to each multiple of n, where a float quotient rounds across it.
+  for (int n : {1, 2, 3, 7, 512, 1000, 1023, 1024, 4095, 8191, 65535, 1 << 21, (1 << 22) - 1}) {
+    const int64_t last = (int64_t(1) << 29) - 1;
+    const int64_t rows = std::min<int64_t>(last / n, (1 << 22) - 1);
+    for (int64_t q : {int64_t(0), int64_t(1), rows / 3, rows / 2, rows - 1, rows})
+      for (int64_t i = q * n - 2; i <= q * n + 2; ++i)
+        if (i >= 0 && i <= last && i / n < (1 << 22)) CHECK(kern::rowOfIndex(int(i), n) == int(i / n));
+  }
+}
+
 TEST_CASE("kern::searchCdf returns the last index i with cdf[i] <= u", "[envmap]") {
   // Every CDF of n ≤ 9 steps over the values {0, 0.25, 0.5, 1} (ties and jumps at
   // both ends), probed at each value it holds and between them.

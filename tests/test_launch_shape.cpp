@@ -39,10 +39,11 @@ bool hasFp64(const cl::Device& device) {
 
 }  // namespace
 
-TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pass counts", "[launch]") {
-  CHECK(sampleKernelLocalBytes(8, 0, true) == 8 * (9 * 8 + 4));
-  CHECK(sampleKernelLocalBytes(256, 15, true) == 256 * (24 * 8 + 4));
-  CHECK(sampleKernelLocalBytes(64, 6, false) == 64 * (15 * 4 + 4));
+TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pixel's rows, the pass counts",
+          "[launch]") {
+  CHECK(sampleKernelLocalBytes(8, 0, true) == 8 * (9 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(256, 15, true) == 256 * (24 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(64, 6, false) == 64 * (15 * 4 + 11 * 4));
 }
 
 TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
@@ -51,12 +52,12 @@ TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums,
   REQUIRE(many == 15);
   LaunchShape wide = chooseLocalSize(gpu(), sampleBytes(few));
   CHECK(wide.localSize == 256);
-  CHECK(wide.why == "GPU: 256 work-items, 31 KiB of 48 KiB local memory");
-  // 256 × (24 doubles + an int) = 49 KiB: one KiB over.
+  CHECK(wide.why == "GPU: 256 work-items, 41 KiB of 48 KiB local memory");
+  // 256 × (24 doubles + 11 ints) = 59 KiB: over.
   LaunchShape narrow = chooseLocalSize(gpu(), sampleBytes(many));
   CHECK(narrow.localSize == 128);
   CHECK(narrow.why ==
-        "GPU: 128 work-items, 24.5 KiB of 48 KiB local memory; 256 would need 49 KiB of local memory, the device has "
+        "GPU: 128 work-items, 29.5 KiB of 48 KiB local memory; 256 would need 59 KiB of local memory, the device has "
         "48 KiB");
 }
 
@@ -64,7 +65,7 @@ TEST_CASE("launch shape: a GPU's work-group limit and lockstep width bound the s
   LaunchShape capped = chooseLocalSize(gpu(64), sampleBytes(0));
   CHECK(capped.localSize == 64);
   CHECK(capped.why ==
-        "GPU: 64 work-items, 4.8 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
+        "GPU: 64 work-items, 7.2 KiB of 48 KiB local memory; 128 exceeds the device's 64 work-items "
         "per group");
   // A wavefront of 64 skips 32; below every preferred size the largest that fits runs.
   CHECK(chooseLocalSize(gpu(1024, k48KiB, 64), sampleBytes(0)).localSize == 256);
@@ -83,13 +84,13 @@ TEST_CASE("launch shape: a CPU runs 8 work-items (docs/pocl.md rule 4)", "[launc
 TEST_CASE("launch shape: --local-size is taken if it fits and refused naming the limit if not", "[launch]") {
   LaunchShape given = chooseLocalSize(gpu(), sampleBytes(15), 64);
   CHECK(given.localSize == 64);
-  CHECK(given.why == "GPU: 64 work-items as --local-size asked, 12.2 KiB of 48 KiB local memory");
+  CHECK(given.why == "GPU: 64 work-items as --local-size asked, 14.8 KiB of 48 KiB local memory");
   try {
     chooseLocalSize(gpu(), sampleBytes(15), 256);
     FAIL("an override that needs more local memory than the device has was taken");
   } catch (const DeviceError& e) {
     CHECK(std::string(e.what()) ==
-          "--local-size 256: the sampling kernel does not fit this GPU: 256 would need 49 KiB of local memory, the "
+          "--local-size 256: the sampling kernel does not fit this GPU: 256 would need 59 KiB of local memory, the "
           "device has 48 KiB");
   }
   CHECK_THROWS_WITH(chooseLocalSize(gpu(512), sampleBytes(0), 1024),

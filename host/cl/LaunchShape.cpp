@@ -14,6 +14,9 @@ namespace {
 
 // kernels/sample.cl's SUM_COUNT: R, G, B, and per technique Σ w and Σ w².
 constexpr size_t kSampleSums = 9;
+// kernels/sample.cl's ROW_COUNT: the pixel's BRDF, BRDF bin, counts and first indices,
+// 32-bit words read once before the sample loop.
+constexpr size_t kPixelRows = 10;
 
 // PoCL vectorises a work-group across 8 work-items fastest (docs/pocl.md, rule 4).
 constexpr int kCpuLocalSize = 8;
@@ -60,7 +63,7 @@ DeviceLimits deviceLimits(const cl::Device& device) {
 
 size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums) {
   const size_t acc = doubleSums ? sizeof(double) : sizeof(float);
-  return size_t(localSize) * ((kSampleSums + size_t(statSlots)) * acc + sizeof(cl_int));
+  return size_t(localSize) * ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + 1) * sizeof(cl_int));
 }
 
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,

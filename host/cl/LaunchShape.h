@@ -25,9 +25,9 @@ struct DeviceLimits {
 // kernel-free OpenCL 1.2 queries say nothing about it.
 DeviceLimits deviceLimits(const cl::Device& device);
 
-// The local memory of sampleStage at this work-group size: its sums, running sums
-// (`statSlots`, StageStatistics::statSlots()) and pass counts, in double where
-// `doubleSums` (ma_acc, kernels/common.h) else float. With no running sums the kernel
+// The local memory of sampleStage at this work-group size: its sums and running sums
+// (`statSlots`, StageStatistics::statSlots()), in double where `doubleSums` (ma_acc,
+// kernels/common.h) else float, and per work-item its pixel's rows and pass count. With no running sums the kernel
 // declares a one-row placeholder that it never touches: PoCL and clang's nvptx64
 // back end both drop it, so it is not counted.
 size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums);

@@ -26,6 +26,10 @@ void requireValidSize(const Envmap& envmap) {
   if (int64_t(image.width) * image.height * 4 > INT_MAX)
     throw InputError(fmt::format("envmap '{}' has {}×{} texels, too many for the kernels' 32-bit indices (at most {})",
                                  envmap.description, image.width, image.height, INT_MAX / 4));
+  // kernels/envmap.h's rowOfIndex divides texel and block indices by the width in float.
+  if (image.width >= (1 << 22) || image.height >= (1 << 22))
+    throw InputError(fmt::format("envmap '{}' has {}×{} texels: the kernels take at most {} a side", envmap.description,
+                                 image.width, image.height, (1 << 22) - 1));
   if (image.width < 1 || image.height < 1 ||
       image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(fmt::format("envmap '{}' has {}×{} texels and {} floats", envmap.description,
