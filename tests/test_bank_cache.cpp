@@ -73,6 +73,15 @@ TEST_CASE("a cached bank is the bank a build gives, bit for bit", "[bankcache][o
   }
 }
 
+TEST_CASE("a black map's bank, plain tables with empty bank arrays, is cached too", "[bankcache][optimal]") {
+  TempCache cache;
+  const Scene built = smallScene("constant:0", "seed000", 16, 16, false, EnvmapSampler::Alias, 0, "optimal");
+  optimalScene("constant:0", "seed000", cache.path.string());
+  const Scene second = optimalScene("constant:0", "seed000", cache.path.string());
+  CHECK(second.tables.bankFromCache);
+  checkSameTables(built.tables, second.tables);
+}
+
 TEST_CASE("the bank cache's key names everything the bank is built from", "[bankcache][optimal]") {
   TempCache cache;
   const std::string dir = cache.path.string();

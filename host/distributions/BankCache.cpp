@@ -60,7 +60,7 @@ class Writer {
   template <typename T>
   void vector(const std::vector<T>& v) {
     value(uint64_t(v.size()));
-    bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    if (!v.empty()) bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
   std::string& bytes() { return bytes_; }
 
@@ -90,6 +90,7 @@ class Reader {
  private:
   void take(void* out, size_t n) {
     if (n > end_ - at_) throw std::runtime_error("the file ends early");
+    if (n == 0) return;  // an empty table's data() may be null, which memcpy must not see
     std::memcpy(out, bytes_.data() + at_, n);
     at_ += n;
   }
