@@ -89,6 +89,15 @@ void compareAtEqualTime(CaseSummary& c) {
   }
 }
 
+std::optional<CostModelAccuracy> costModelAccuracy(const std::vector<RunRecord>& runs) {
+  std::vector<double> errors;
+  for (const RunRecord& r : runs)
+    for (const StageTiming& t : r.stages)
+      if (t.predictedKernelSeconds) errors.push_back(std::abs(*t.predictedKernelSeconds / t.kernelSeconds - 1));
+  if (errors.empty()) return std::nullopt;
+  return CostModelAccuracy{int(errors.size()), median(errors), *std::max_element(errors.begin(), errors.end())};
+}
+
 }  // namespace
 
 ErrorCurve MethodSummary::curve() const {
@@ -107,17 +116,6 @@ const MethodSummary* CaseSummary::find(Method method) const {
   for (const MethodSummary& m : methods)
     if (m.method == method) return &m;
   return nullptr;
-}
-
-std::optional<CostModelAccuracy> costModelAccuracy(const std::vector<RunRecord>& runs) {
-  std::vector<double> errors;
-  for (const RunRecord& r : runs)
-    for (const StageTiming& t : r.stages)
-      if (t.predictedKernelSeconds) errors.push_back(std::abs(*t.predictedKernelSeconds / t.kernelSeconds - 1));
-  if (errors.empty()) return std::nullopt;
-  std::sort(errors.begin(), errors.end());
-  const size_t n = errors.size();
-  return CostModelAccuracy{int(n), n % 2 ? errors[n / 2] : (errors[n / 2 - 1] + errors[n / 2]) / 2, errors.back()};
 }
 
 Summary summarize(const Comparison& comparison, const CompareOptions& options) {

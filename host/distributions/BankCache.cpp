@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <cstdio>
@@ -13,6 +12,7 @@
 #include <variant>
 
 #include "AtomicFile.h"
+#include "ContentHash.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
@@ -21,32 +21,6 @@ namespace {
 // Bumped whenever the tables or this layout change: older entries then miss.
 constexpr char kMagic[8] = {'M', 'A', 'B', 'A', 'N', 'K', '0', '1'};
 
-// A 64-bit content hash that takes 8 bytes per multiply: the key hashes every texel of
-// the map, and a cache hit must cost a small part of the build it saves.
-struct WordHash {
-  uint64_t h = 0x9e3779b97f4a7c15ull;
-  void add(const void* data, size_t n) {
-    auto* p = static_cast<const unsigned char*>(data);
-    size_t i = 0;
-    for (; i + 8 <= n; i += 8) {
-      uint64_t w;
-      std::memcpy(&w, p + i, 8);
-      mix(w);
-    }
-    uint64_t tail = n;
-    for (; i < n; ++i) tail = (tail << 8) | p[i];
-    mix(tail);
-  }
-  void mix(uint64_t w) {
-    h = (h ^ w) * 0xff51afd7ed558ccdull;
-    h ^= h >> 32;
-  }
-  template <typename T>
-  void addValue(T v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    add(&v, sizeof v);
-  }
-};
 
 // The entry's bytes: plain values and length-prefixed vectors, in one order for both
 // directions.
@@ -115,7 +89,7 @@ void transfer(Io& io, Tables& t, std::vector<float>& texelProbabilities) {
 }
 
 uint64_t checksum(const char* data, size_t n) {
-  WordHash h;
+  ContentHash h;
   h.add(data, n);
   return h.h;
 }
@@ -177,7 +151,7 @@ std::optional<std::string> readWhole(const std::string& path) {
 
 std::string bankCacheKey(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
                          const std::array<float, 3>& mirror, const OptimalBankOptions& options) {
-  WordHash h;
+  ContentHash h;
   h.addValue(envmap.image.width);
   h.addValue(envmap.image.height);
   h.add(envmap.image.rgb.data(), envmap.image.rgb.size() * sizeof(float));
@@ -199,14 +173,12 @@ std::string bankCachePath(const std::string& cacheDir, const std::string& key) {
 
 std::optional<EnvmapTables> readCachedBank(const std::string& cacheDir, const std::string& key,
                                            const RgbImage& image) {
-  const auto start = std::chrono::steady_clock::now();
   const std::string path = bankCachePath(cacheDir, key);
   std::optional<std::string> bytes = readWhole(path);
   if (!bytes) return std::nullopt;
   auto decoded = decode(*bytes, key, image);
   if (auto* tables = std::get_if<EnvmapTables>(&decoded)) {
     tables->bankFromCache = true;
-    tables->bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return std::move(*tables);
   }
   std::cerr << fmt::format("misalloc: the optimal pdf's cached tables {} are damaged ({}); building them again\n", path,

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "AtomicFile.h"
+#include "ContentHash.h"
 #include "Error.h"
 #include "FileLock.h"
 #include "render/Method.h"
@@ -21,19 +22,6 @@ namespace {
 constexpr uint32_t kReferenceFirstIndex = 1u << 31;
 constexpr uint64_t kReferenceSeed = 0x8000000000005eedull;
 
-// FNV-1a, 64 bits: a stable content hash for cache keys.
-struct Fnv1a {
-  uint64_t h = 0xcbf29ce484222325ull;
-  void add(const void* data, size_t n) {
-    auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  }
-  void add(const std::string& s) { add(s.data(), s.size() + 1); }
-  template <typename T>
-  void addValue(T v) {
-    add(&v, sizeof v);
-  }
-};
 
 }  // namespace
 
@@ -103,7 +91,7 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
 }
 
 std::string referenceKey(const Scene& scene, int spp) {
-  Fnv1a h;
+  ContentHash h;
   const EnvmapTables& env = scene.tables;
   h.addValue(env.width);
   h.addValue(env.height);
@@ -143,7 +131,7 @@ std::string cacheLockPath(const std::string& key, const std::string& cacheDir) {
 const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_error.G", "standard_error.B"};
 
 uint64_t pixelChecksum(const SampledReference& reference) {
-  Fnv1a h;
+  ContentHash h;
   h.add(reference.image.rgb.data(), reference.image.rgb.size() * sizeof(float));
   h.add(reference.standardError.data(), reference.standardError.size() * sizeof(float));
   return h.h;

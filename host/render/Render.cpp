@@ -134,11 +134,7 @@ std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocatio
 
 // The pilot: every pixel splits its first stage equally.
 std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
-  std::vector<int> counts = apportionCounts(std::vector<double>(M, 1.0), stageSamples);
-  std::vector<int32_t> out;
-  out.reserve(size_t(pixels) * M);
-  for (int p = 0; p < pixels; ++p) out.insert(out.end(), counts.begin(), counts.end());
-  return out;
+  return sameCountsEverywhere(pixels, apportionCounts(std::vector<double>(M, 1.0), stageSamples));
 }
 
 // The largest stage that keeps statistics (all but the last) whatever the technique

@@ -59,12 +59,12 @@ void CostModel::fit(Kernel& kernel) {
     const Eigen::VectorXd solution = sub.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(n));
     x.setZero();
     for (size_t j = 0; j < free.size(); ++j) x(free[j]) = solution(int(j));
-    auto leaving = free.end();
-    for (auto j = free.begin(); j != free.end(); ++j)
-      if (*j == 0 ? x(0) < 0 : x(*j) <= 0) {
-        if (*j == 0 || leaving == free.end() || (*leaving != 0 && x(*j) < x(*leaving))) leaving = j;
-      }
-    if (leaving == free.end()) break;
+    // t_0 leaves when negative, else the least c_k when it is not positive.
+    const bool interceptFree = free.front() == 0;
+    auto leaving = interceptFree && x(0) < 0 ? free.begin()
+                                             : std::min_element(free.begin() + (interceptFree ? 1 : 0), free.end(),
+                                                                [&](int i, int j) { return x(i) < x(j); });
+    if (leaving == free.end() || (*leaving != 0 && x(*leaving) > 0)) break;
     x(*leaving) = 0;
     free.erase(leaving);
   }
@@ -84,7 +84,7 @@ StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bo
   plan.techniqueCount = scene.techniqueCount();
   plan.keepStatistics = keepStatistics;
   for (int n : counts) plan.stageSamples += n;
-  for (int p = 0; p < scene.pixelCount(); ++p) plan.counts.insert(plan.counts.end(), counts.begin(), counts.end());
+  plan.counts = sameCountsEverywhere(scene.pixelCount(), counts);
   plan.firstIndex.assign(plan.counts.size(), 0u);
   return plan;
 }

@@ -28,6 +28,14 @@ struct StagePlan {
   bool keepStatistics = true;
 };
 
+// A stage's counts [pixel·M + k] where every pixel takes the same `counts` ([k]).
+inline std::vector<int32_t> sameCountsEverywhere(int pixels, const std::vector<int>& counts) {
+  std::vector<int32_t> out;
+  out.reserve(std::size_t(pixels) * counts.size());
+  for (int p = 0; p < pixels; ++p) out.insert(out.end(), counts.begin(), counts.end());
+  return out;
+}
+
 // The pixels [begin, end) of the image, in index order: a tile of a stage.
 struct PixelRange {
   int begin = 0, end = 0;

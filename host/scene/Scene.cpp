@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -84,8 +85,11 @@ Scene makeScene(const SceneOptions& options) {
           "for the BRDF as one technique (M = 2)");
     std::optional<EnvmapTables> cached;
     if (!options.bankCacheDir.empty()) {
+      const auto start = std::chrono::steady_clock::now();
       scene.bankCacheKey = bankCacheKey(scene.envmap, options.sampler, scene.grid, scene.mirror);
       cached = readCachedBank(options.bankCacheDir, scene.bankCacheKey, scene.envmap.image);
+      // A hit costs its key (every texel hashed) and its read.
+      if (cached) cached->bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     scene.tables = cached ? std::move(*cached)
                           : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
