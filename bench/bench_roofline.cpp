@@ -61,43 +61,48 @@ uint32_t xorshift(uint32_t x) {
   return x ^ (x << 5);
 }
 
-// Random reads of one `Words`-word record of `table` per stream and step.
-template <int Words>
-float randomReads(const std::vector<uint32_t>& table, int64_t steps) {
-  const uint32_t records = uint32_t(table.size() / Words);
+// kStreams independent random streams per thread, each taking `steps` steps of
+// `read(random)`, which returns what it read; the sum keeps the reads alive.
+template <typename Read>
+float randomStreams(int64_t steps, Read read) {
   uint32_t state[kStreams];
   float sum[kStreams] = {};
   for (int s = 0; s < kStreams; ++s) state[s] = 0x9e3779b9u * uint32_t(s + 1 + 97 * omp_get_thread_num());
   for (int64_t i = 0; i < steps; ++i)
     for (int s = 0; s < kStreams; ++s) {
       state[s] = xorshift(state[s]);
-      const uint32_t* record = table.data() + size_t(uint64_t(state[s]) * records >> 32) * Words;
-      for (int w = 0; w < Words; ++w) sum[s] += float(record[w]);
+      sum[s] += read(state[s]);
     }
   float total = 0;
   for (float v : sum) total += v;
   return total;
 }
 
+// Random reads of one `Words`-word record of `table` per stream and step.
+template <int Words>
+float randomReads(const std::vector<uint32_t>& table, int64_t steps) {
+  const uint32_t records = uint32_t(table.size() / Words);
+  return randomStreams(steps, [&](uint32_t random) {
+    const uint32_t* record = table.data() + size_t(uint64_t(random) * records >> 32) * Words;
+    float read = 0;
+    for (int w = 0; w < Words; ++w) read += float(record[w]);
+    return read;
+  });
+}
+
 // The alias sampler's two dependent reads: a bucket's (acceptance, alias), then the
 // four words of the texel drawn, as kernels/envmap.h's sampleAliasTable and envmapTexelHit.
 float aliasPairs(const std::vector<uint32_t>& alias, const std::vector<uint32_t>& texels, int64_t steps) {
   const uint32_t buckets = uint32_t(alias.size() / 2);
-  uint32_t state[kStreams];
-  float sum[kStreams] = {};
-  for (int s = 0; s < kStreams; ++s) state[s] = 0x9e3779b9u * uint32_t(s + 1 + 97 * omp_get_thread_num());
-  for (int64_t i = 0; i < steps; ++i)
-    for (int s = 0; s < kStreams; ++s) {
-      state[s] = xorshift(state[s]);
-      const uint32_t bucket = uint32_t(uint64_t(state[s]) * buckets >> 32);
-      float accept;
-      std::memcpy(&accept, &alias[2 * bucket], 4);
-      const uint32_t t = float(state[s] & 0xffffffu) * (1.0f / 16777216.0f) < accept ? bucket : alias[2 * bucket + 1];
-      for (int w = 0; w < 4; ++w) sum[s] += float(texels[4 * size_t(t) + w]);
-    }
-  float total = 0;
-  for (float v : sum) total += v;
-  return total;
+  return randomStreams(steps, [&](uint32_t random) {
+    const uint32_t bucket = uint32_t(uint64_t(random) * buckets >> 32);
+    float accept;
+    std::memcpy(&accept, &alias[2 * bucket], 4);
+    const uint32_t t = float(random & 0xffffffu) * (1.0f / 16777216.0f) < accept ? bucket : alias[2 * bucket + 1];
+    float read = 0;
+    for (int w = 0; w < 4; ++w) read += float(texels[4 * size_t(t) + w]);
+    return read;
+  });
 }
 
 // 16 independent chains of 16-lane fp32 fmas, held in registers (unrolled), fused
