@@ -78,6 +78,22 @@ TEST_CASE("merged bands are the unsharded render bit for bit, for every method",
   }
 }
 
+TEST_CASE("a band leaves the optimal pdf's cached tables to the whole image", "[band][cli][bankcache]") {
+  TempDir dir("band_cache");
+  const std::string cold = "--cache-dir " + (dir.path / "cache").string();
+  renderBands(dir.path, "exact", cold, 3, {1});
+  // A band's tables cover its own rows: cached under the image's key, they would
+  // give the whole image's pixels the wrong bins (and read past their end).
+  for (const char* cache : {"cache", "cache", "fresh"}) {
+    auto whole = runMisalloc(renderArgs(dir.path, "exact",
+                                        fmt::format("--cache-dir {} --out {}", (dir.path / cache).string(),
+                                                    (dir.path / (std::string(cache) + ".exr")).string())));
+    INFO(whole.output);
+    REQUIRE(whole.exitCode == 0);
+  }
+  CHECK(readText(dir.path / "cache.exr") == readText(dir.path / "fresh.exr"));
+}
+
 TEST_CASE("merge refuses bands that do not make one run's image, and writes nothing", "[band][cli][safety]") {
   TempDir dir("band_refusals");
   renderBands(dir.path, "exact", "", 3, {0, 1, 2});
