@@ -38,12 +38,9 @@ double rate(const std::function<float(int64_t)>& run, double perStep, int repeat
   float sink = 0;
   while (int(rates.size()) < repeats) {
     auto start = std::chrono::steady_clock::now();
-    int threads = 1;
+    const int threads = omp_get_max_threads();
 #pragma omp parallel reduction(+ : sink)
-    {
-      threads = omp_get_num_threads();
-      sink += run(steps);
-    }
+    sink += run(steps);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (seconds < 0.3) {
       steps *= 2;

@@ -90,12 +90,14 @@ MA_FN float blockProbability(EnvmapView env, int t) {
   return env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + blockOfTexel(env, t)];
 }
 
-// The probability that envmap sampling draws texel t.
-MA_FN float texelProbability(EnvmapView env, int t) {
-  float p = env.texels[4 * t + 3];
-  if (env.bankShares > 0) p *= blockProbability(env, t);
-  return p;
+// The probability that envmap sampling draws texel t, from p, its probability within
+// its block (the optimal pdf's bank) or in the map.
+MA_FN float bankedProbability(EnvmapView env, int t, float p) {
+  return env.bankShares > 0 ? p * blockProbability(env, t) : p;
 }
+
+// The probability that envmap sampling draws texel t.
+MA_FN float texelProbability(EnvmapView env, int t) { return bankedProbability(env, t, env.texels[4 * t + 3]); }
 
 // A texel picked with probability P is spread uniformly over its (u, v) area 1/(WH),
 // and dω = 2π² sin θ du dv, so p(ω) = P W H / (2π² sin θ).
@@ -114,9 +116,7 @@ MA_FN EnvmapHit envmapTexelHit(EnvmapView env, int t, MaVec3 w) {
     hit.g = ma_as_float(highWord(rg));
     hit.b = ma_as_float(lowWord(bp));
   }
-  float p = ma_as_float(highWord(bp));
-  if (env.bankShares > 0) p *= blockProbability(env, t);
-  hit.pdf = envmapPdfOfTexel(env, p, ma_sqrt(w.x * w.x + w.y * w.y));
+  hit.pdf = envmapPdfOfTexel(env, bankedProbability(env, t, ma_as_float(highWord(bp))), ma_sqrt(w.x * w.x + w.y * w.y));
   return hit;
 }
 

@@ -137,7 +137,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   int start = 0;  // the pass's first sample in the stage
   MA_UNROLL
   for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
-    int n = MA_ONE_SAMPLE ? stageSamples : counts[pixel * MA_TECHNIQUES + k];
+    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[(ROW_N0 + k) * MA_LOCAL_SIZE + lid];
     passCounts[lid] = n;
     barrier(CLK_LOCAL_MEM_FENCE);
     int passSamples = 0;
