@@ -77,12 +77,16 @@ MA_FN int blockOfTexel(EnvmapView env, int t) {
   return (row >> env.blockLog2) * blocksAcross(env) + (col >> env.blockLog2);
 }
 
+// The share C_i = (i+1)/(shares+1) nearest an envmap fraction α_0.
+MA_FN int bankShareOf(int shares, float envmapFraction) {
+  int share = (int)(envmapFraction * (float)(shares + 1) + 0.5f) - 1;
+  return share < 0 ? 0 : (share >= shares ? shares - 1 : share);
+}
+
 // The pixel's stage samples with the entry of its BRDF bin whose share C is nearest
 // the stage's envmap fraction α_0: [Kar19] eq. 9 for the C that is actually run.
 MA_FN int bankEntryOf(EnvmapView env, float envmapFraction) {
-  int share = (int)(envmapFraction * (float)(env.bankShares + 1) + 0.5f) - 1;
-  share = share < 0 ? 0 : (share >= env.bankShares ? env.bankShares - 1 : share);
-  return env.brdfBin * env.bankShares + share;
+  return env.brdfBin * env.bankShares + bankShareOf(env.bankShares, envmapFraction);
 }
 
 // The bank's factor of texel t's probability: the probability of drawing its block.
@@ -103,6 +107,22 @@ MA_FN float texelProbability(EnvmapView env, int t) { return bankedProbability(e
 // and dω = 2π² sin θ du dv, so p(ω) = P W H / (2π² sin θ).
 MA_FN float envmapPdfOfTexel(EnvmapView env, float texelProbability, float sinTheta) {
   return texelProbability * (float)env.width * (float)env.height / (2.0f * MA_PI * MA_PI * ma_max(sinTheta, 1e-7f));
+}
+
+// The most shares a bank has (host/distributions/OptimalBank.h, OptimalBankOptions).
+#define MA_MAX_BANK_SHARES 3
+
+// The envmap's pdf at ω in texel t under every share of the pixel's BRDF bin, each as
+// envmapTexelHit computes it for that share's entry: what a stage of each share would
+// sample ω with. The grid search weighs each α_0 with the share that a stage of that
+// α_0 samples with (kernels/stats.h, stored columns). Shares past bankShares are 0.
+MA_FN void bankSharePdfs(EnvmapView env, int t, float sinTheta, float* pdfs) {
+  float p = env.texels[4 * t + 3];
+  MA_UNROLL
+  for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
+    env.bankEntry = env.brdfBin * env.bankShares + s;
+    pdfs[s] = s < env.bankShares ? envmapPdfOfTexel(env, bankedProbability(env, t, p), sinTheta) : 0.0f;
+  }
 }
 
 // Radiance and pdf at ω inside texel t: the texel's four words as two 64-bit reads.

@@ -18,6 +18,7 @@ typedef struct {
   int techniqueCount;  // M
   int splitBrdf;       // M = 3: the BRDF's lobes are techniques of their own
   MaVec3 mirror;       // mirror direction of ω_o about the normal (z)
+  int sharePdfs;       // 1: evaluateSample also gives the envmap's pdf under every share of the bank
 } TechniqueSet;
 
 typedef struct {
@@ -59,6 +60,7 @@ MA_FN float mixturePdf(int techniqueCount, const float* alpha, const float* pdfs
 typedef struct {
   float r, g, b;  // f(ω_i) = L(ω_i) f_r(ω_o, ω_i) cos θ_i
   float pdfs[MA_MAX_TECHNIQUES];
+  float sharePdfs[MA_MAX_BANK_SHARES];  // TechniqueSet::sharePdfs: bankSharePdfs at ω_i, else 0
 } SampleValue;
 
 // f and every p_k at the direction that `technique` drew. A constant `technique` folds
@@ -76,6 +78,9 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b,
   s.g = hit.g * brdfCos;
   s.b = hit.b * brdfCos;
   techniquePdfs(ts, b, wi, hit.pdf, lobe, s.pdfs);
+  MA_UNROLL
+  for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
+  if (ts.sharePdfs) bankSharePdfs(env, texel, ma_sqrt(wi.x * wi.x + wi.y * wi.y), s.sharePdfs);
   return s;
 }
 

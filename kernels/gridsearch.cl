@@ -4,8 +4,9 @@
 // combinations, 16 of them per float16, and selects from the sums. Host side and C++
 // reference: host/alloc/GridSearch.h. What both share: kernels/gridsearch.h.
 //
-// Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M) and
-// MA_GRID_VECTORS (B), the float16s of combinations summed in one pass over the samples.
+// Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M, the stored
+// samples' columns), MA_SHARE_COLUMNS (S, kernels/stats.h) and MA_GRID_VECTORS (B), the
+// float16s of combinations summed in one pass over the samples.
 //
 // Shape (docs/pocl.md): explicit float16 arithmetic is what
 // reaches 512-bit code on PoCL. Lanes are combinations, not pixels, so a sample's
@@ -250,7 +251,7 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
   PixelSummary added[16];
   for (int lane = 0; lane < 16; ++lane) added[lane] = emptySummary();
   for (int i = 0; i < taken; ++i)
-    for (int lane = 0; lane < 16; ++lane) summariseSample(&added[lane], blockSamples + lane, MA_TECHNIQUES, i);
+    for (int lane = 0; lane < 16; ++lane) summariseSample(&added[lane], blockSamples + lane, MA_TECHNIQUES, MA_SHARE_COLUMNS, i);
   PixelSummary all[16];
   uint fallbacks[16];
   int next[16][MA_TECHNIQUES];

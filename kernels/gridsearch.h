@@ -17,6 +17,10 @@
 #define MA_RULE_MAX_ENTROPY 0        // as written: λ_{j,l} closest to uniform by entropy
 #define MA_RULE_MIN_COST_VARIANCE 1  // least cost × variance of the multi-sample estimator
 
+// The search's techniques are the stored samples' columns (kernels/stats.h): one per
+// technique, or with share columns S > 0 the envmap's pdf under each share of the
+// optimal pdf's bank, then the other techniques; below, M counts columns.
+//
 // Value q of a pixel's sample i, with `pixelSamples` at the pixel's first value: the
 // layout of kernels/stats.h (storedSampleIndex), records of M + 2 rows of 16 pixels.
 MA_FN float storedValue(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, int q) {
@@ -38,7 +42,7 @@ MA_FN float inversePowerOfTwo(float x) {
 typedef struct {
   float count[MA_GRID_MAX_TECHNIQUES];  // m_j
   int nonZero[MA_GRID_MAX_TECHNIQUES];  // technique j's samples with f > 0; 0: silent
-  float maxRatio;                       // max_i f_i / Σ_k p_k(x_i)
+  float maxRatio;                       // max_i f_i / leastPdfSum(x_i)
   // A NaN, infinite or negative f or pdf, f > 0 where every pdf is 0, or a technique
   // index outside 0 … M−1.
   int invalid;
@@ -66,16 +70,35 @@ MA_FN PixelSummary mergeSummaries(PixelSummary a, PixelSummary b) {
   return a;
 }
 
-MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples, int techniqueCount, int i) {
+// The least Σ_k p_k over the columns that a combination weighs: all of them, or with
+// share columns one share's and the other techniques'. p_α ≥ (min_k α_k) times it, the
+// minimum over the columns the combination weighs.
+MA_FN float leastPdfSum(int techniqueCount, int shareColumns, const float* pdf) {
+  float shareMin = pdf[0], rest = 0.0f;
+  MA_UNROLL
+  for (int k = 1; k < MA_GRID_MAX_TECHNIQUES; ++k) {
+    int used = k < techniqueCount, share = k < shareColumns;
+    shareMin = used && share ? ma_min(shareMin, pdf[k]) : shareMin;
+    rest += used && !share ? pdf[k] : 0.0f;
+  }
+  float sum = 0.0f;
+  MA_UNROLL
+  for (int k = 0; k < MA_GRID_MAX_TECHNIQUES; ++k) sum += k < techniqueCount ? pdf[k] : 0.0f;
+  return shareColumns > 0 ? shareMin + rest : sum;
+}
+
+MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples, int techniqueCount, int shareColumns,
+                           int i) {
   float technique = storedValue(pixelSamples, techniqueCount, i, 0);
-  float f = storedValue(pixelSamples, techniqueCount, i, 1), pSum = 0.0f;
+  float f = storedValue(pixelSamples, techniqueCount, i, 1), pdf[MA_GRID_MAX_TECHNIQUES];
   int invalid = !(f >= 0.0f && f <= FLT_MAX), drawn = 0;
   MA_UNROLL
-  for (int k = 0; k < techniqueCount; ++k) {
-    float p = storedValue(pixelSamples, techniqueCount, i, 2 + k);
+  for (int k = 0; k < MA_GRID_MAX_TECHNIQUES; ++k) {
+    float p = k < techniqueCount ? storedValue(pixelSamples, techniqueCount, i, 2 + k) : 0.0f;
     invalid |= !(p >= 0.0f && p <= FLT_MAX);
-    pSum += p;
+    pdf[k] = p;
   }
+  float least = leastPdfSum(techniqueCount, shareColumns, pdf);
   MA_UNROLL
   for (int j = 0; j < techniqueCount; ++j) {
     int t = technique == (float)j;
@@ -83,11 +106,11 @@ MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples,
     s->count[j] += t ? 1.0f : 0.0f;
     s->nonZero[j] += t && f > 0.0f;
   }
-  s->invalid |= invalid || !drawn || (f > 0.0f && pSum == 0.0f);
-  s->maxRatio = ma_max(s->maxRatio, pSum > 0.0f ? f / pSum : 0.0f);
+  s->invalid |= invalid || !drawn || (f > 0.0f && least == 0.0f);
+  s->maxRatio = ma_max(s->maxRatio, least > 0.0f ? f / least : 0.0f);
 }
 
-// The scale of g: since p_α ≥ (min_k α_k) Σ_k p_k and scale · max_i f_i/Σ_k p_k < 4
+// The scale of g: since p_α ≥ (min_k α_k) leastPdfSum and scale · max_i f_i/leastPdfSum < 4
 // (2 but where inversePowerOfTwo clamps), every scaled g = scale · f / p_α is below
 // 4 / min_k α_k, so float sums of g² cannot overflow. A power of two, so that sums
 // taken at one scale convert exactly to the next (sumsRescale).

@@ -42,10 +42,12 @@ MA_FN ma_uint firstIndexOf(StageCounts c, int technique) {
 
 typedef struct {
   int technique;
+  int share;      // the bank's share the stage's envmap samples draw with (bankShareOf); 0 without a bank
   float r, g, b;  // the sample's term of the stage estimate
   float w;        // its luminance value: Y(f)/p_α (balance), Y(f)/Σ_k p_k (count-independent)
   float y;        // Y(f)
   float pdfs[MA_MAX_TECHNIQUES];
+  float sharePdfs[MA_MAX_BANK_SHARES];  // SampleValue::sharePdfs
 } SampleContribution;
 
 typedef struct {
@@ -84,6 +86,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float invP = p > 0.0f ? 1.0f / p : 0.0f;
   SampleContribution out;
   out.technique = technique;
+  out.share = env.bankShares > 0 ? bankShareOf(env.bankShares, alpha[0]) : 0;
   out.r = s.r * invP / scale;
   out.g = s.g * invP / scale;
   out.b = s.b * invP / scale;
@@ -91,6 +94,8 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   out.w = out.y * invP;
   MA_UNROLL
   for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) out.pdfs[k] = s.pdfs[k];
+  MA_UNROLL
+  for (int k = 0; k < MA_MAX_BANK_SHARES; ++k) out.sharePdfs[k] = s.sharePdfs[k];
   return out;
 }
 

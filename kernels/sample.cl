@@ -6,7 +6,8 @@
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
 // MA_COSK (< 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
 // bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the
-// running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_LOCAL_SIZE. Constants fold the
+// running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
+// samples' share columns, kernels/stats.h; 0: none), MA_LOCAL_SIZE. Constants fold the
 // unused techniques, sampler, estimator and statistics away.
 //
 // No contraction of a*b + c into fma but where the code says fma: the C++ reference is
@@ -17,6 +18,7 @@
 #include "stats.h"
 
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
+#define SAMPLE_COLUMNS MA_STORED_COLUMNS(MA_TECHNIQUES, MA_SHARE_COLUMNS)
 
 // The per-pixel sums live in local memory, one row per sum: PoCL then keeps nothing
 // but the loop counter across the barrier, and nothing that its earlier passes could
@@ -73,6 +75,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   ts.techniqueCount = MA_TECHNIQUES;
   ts.splitBrdf = MA_SPLIT_BRDF;
   ts.mirror = mirror;
+  ts.sharePdfs = MA_SHARE_COLUMNS > 0;
 
   PhongParams b;
   b.rhoD = as_float(PIXEL_ROW(ROW_RHO_D));
@@ -168,11 +171,13 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       }
       if (MA_STORE_SAMPLES && counted && gid < pixelCount) {
         int i = firstSlot + j;
-        samples[storedSampleIndex(pixel, i, 0, sampleCapacity, MA_TECHNIQUES)] = (float)c.technique;
-        samples[storedSampleIndex(pixel, i, 1, sampleCapacity, MA_TECHNIQUES)] = c.y;
+        samples[storedSampleIndex(pixel, i, 0, sampleCapacity, SAMPLE_COLUMNS)] =
+            (float)storedColumn(c, MA_SHARE_COLUMNS);
+        samples[storedSampleIndex(pixel, i, 1, sampleCapacity, SAMPLE_COLUMNS)] = c.y;
         MA_UNROLL
-        for (int l = 0; l < MA_TECHNIQUES; ++l)
-          samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, MA_TECHNIQUES)] = c.pdfs[l];
+        for (int l = 0; l < SAMPLE_COLUMNS; ++l)
+          samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, SAMPLE_COLUMNS)] =
+              storedPdf(c, MA_SHARE_COLUMNS, l);
       }
       barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
     }

@@ -46,11 +46,37 @@ MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
 // keeps them all; the grid searches of exact and oracle (kernels/gridsearch.cl) keep
 // running sums and need only those taken since the previous search. Blocked by 16
 // pixels for float16 loads: value q of the pixel's sample in slot i is at
-// ((block·capacity + i)(M + 2) + q)·16 + lane, with q = 0 the technique, 1 the
-// luminance f, 2 + l the pdf p_l.
-#define MA_SAMPLE_RECORD_FLOATS(techniqueCount) ((techniqueCount) + 2)
-MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int techniqueCount) {
-  return (((pixel / 16) * capacity + i) * MA_SAMPLE_RECORD_FLOATS(techniqueCount) + q) * 16 + pixel % 16;
+// ((block·capacity + i)(C + 2) + q)·16 + lane, with q = 0 the column that drew it, 1
+// the luminance f, 2 + l the pdf of column l.
+//
+// The columns are the pdfs an allocation weighs: one per technique, or, with share
+// columns S > 0 (the optimal pdf's bank, for the grid search's rule (b)), the envmap's
+// pdf under each of the S shares of the pixel's BRDF bin, then the other techniques.
+// A combination of the grid then weighs α_0 in the column of the share that a stage of
+// that α_0 samples with, and judges it by the pdf that stage would run.
+#define MA_STORED_COLUMNS(techniqueCount, shareColumns) \
+  ((shareColumns) > 0 ? (shareColumns) + (techniqueCount)-1 : (techniqueCount))
+#define MA_SAMPLE_RECORD_FLOATS(columns) ((columns) + 2)
+MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int columns) {
+  return (((pixel / 16) * capacity + i) * MA_SAMPLE_RECORD_FLOATS(columns) + q) * 16 + pixel % 16;
+}
+
+// The technique whose pdf column l holds.
+MA_FN int techniqueOfColumn(int l, int shareColumns) {
+  return shareColumns > 0 ? (l < shareColumns ? 0 : l - shareColumns + 1) : l;
+}
+
+// The column of the pdf that drew sample s.
+MA_FN int storedColumn(SampleContribution s, int shareColumns) {
+  return shareColumns > 0 ? (s.technique == 0 ? s.share : shareColumns + s.technique - 1) : s.technique;
+}
+
+// Column l's pdf at sample s.
+MA_FN float storedPdf(SampleContribution s, int shareColumns, int l) {
+  int technique = techniqueOfColumn(l, shareColumns);
+  float share = l == 0 ? s.sharePdfs[0] : (l == 1 ? s.sharePdfs[1] : s.sharePdfs[2]);
+  float pdf = technique == 0 ? s.pdfs[0] : (technique == 1 ? s.pdfs[1] : s.pdfs[2]);
+  return shareColumns > 0 && l < shareColumns ? share : pdf;
 }
 
 #endif

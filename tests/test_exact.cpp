@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -33,9 +34,9 @@ struct Sample {
 using PixelSampleList = std::vector<Sample>;
 
 // The pixels' samples in the blocked layout of kernels/stats.h; padding lanes hold
-// technique 0, f = 0 and pdfs 1, as kernels/sample.cl leaves them.
+// column 0, f = 0 and pdfs 1, as kernels/sample.cl leaves them.
 std::vector<float> store(const std::vector<PixelSampleList>& pixels, const StoredSampleLayout& layout) {
-  const int m = layout.techniqueCount;
+  const int m = layout.columns;
   std::vector<float> samples(layout.floatCount(), 1.0f);
   const int paddedPixels = (layout.pixelCount + 15) / 16 * 16;
   for (int pixel = 0; pixel < paddedPixels; ++pixel)
@@ -53,15 +54,16 @@ std::vector<float> store(const std::vector<PixelSampleList>& pixels, const Store
   return samples;
 }
 
-StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, int techniqueCount, int capacity) {
-  return StoredSampleLayout{int(pixels.size()), techniqueCount, capacity, int(pixels.front().size())};
+StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, SampleColumns columns, int capacity) {
+  return StoredSampleLayout{int(pixels.size()), columns.count(), capacity, int(pixels.front().size())};
 }
 
 // One search object per shape, reset before each use: building one compiles the kernel.
-GridSearch& deviceSearch(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true) {
-  static std::map<std::tuple<int, int, int, bool>, std::unique_ptr<GridSearch>> searches;
-  auto& search = searches[{techniqueCount, pixelCount, gridSize, runningSums}];
-  if (!search) search = std::make_unique<GridSearch>(testDevice(), techniqueCount, pixelCount, gridSize, runningSums);
+GridSearch& deviceSearch(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize,
+                         bool runningSums = true) {
+  static std::map<std::tuple<int, int, int, int, bool>, std::unique_ptr<GridSearch>> searches;
+  auto& search = searches[{columns.techniqueCount, columns.shareColumns, pixelCount, gridSize, runningSums}];
+  if (!search) search = std::make_unique<GridSearch>(testDevice(), columns, pixelCount, gridSize, runningSums);
   search->reset();
   return *search;
 }
@@ -75,13 +77,13 @@ struct BothResults {
   GridSearchResult device, reference;
 };
 
-BothResults searchBoth(const std::vector<PixelSampleList>& pixels, int techniqueCount, const std::vector<double>& costs,
-                       GridRule rule, int gridSize = kDefaultGridSize, int capacity = 0,
-                       const std::optional<PooledSelection>& pooling = std::nullopt) {
-  StoredSampleLayout layout = layoutOf(pixels, techniqueCount, std::max(capacity, int(pixels.front().size())));
+BothResults searchBoth(const std::vector<PixelSampleList>& pixels, SampleColumns columns,
+                       const std::vector<double>& costs, GridRule rule, int gridSize = kDefaultGridSize,
+                       int capacity = 0, const std::optional<PooledSelection>& pooling = std::nullopt) {
+  StoredSampleLayout layout = layoutOf(pixels, columns, std::max(capacity, int(pixels.front().size())));
   std::vector<float> samples = store(pixels, layout);
-  GridSearchReference reference(techniqueCount, layout.pixelCount, gridSize);
-  return {deviceSearch(techniqueCount, layout.pixelCount, gridSize)
+  GridSearchReference reference(columns, layout.pixelCount, gridSize);
+  return {deviceSearch(columns, layout.pixelCount, gridSize)
               .run(deviceBuffer(samples), layout, costs, rule, pooling),
           reference.run(samples, layout, costs, rule, pooling)};
 }
@@ -397,7 +399,7 @@ TEST_CASE("a layout that does not match the samples or the search is rejected", 
   StoredSampleLayout overfull = layout, tooLarge = layout, wrongM = layout;
   overfull.taken = layout.capacity + 1;
   tooLarge.pixelCount = 17;  // a second block the buffer does not hold
-  wrongM.techniqueCount = 3;
+  wrongM.columns = 3;
   GridSearchReference reference(2, 3);
   for (const StoredSampleLayout& bad : {overfull, tooLarge, wrongM}) {
     CHECK_THROWS_AS(deviceSearch(2, 3).run(buffer, bad, costs), std::invalid_argument);
@@ -486,4 +488,65 @@ TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not it
                                PooledSelection{width, height, 0, 0.02});
   CHECK(
       std::all_of(own.device.varianceRatio.begin(), own.device.varianceRatio.end(), [](float r) { return r == 1.0f; }));
+}
+
+// Samples of two techniques as share columns (kernels/stats.h): envmap samples drawn
+// with share `drawn`, each share's pdf the envmap's times sharePdf(share, sample).
+std::vector<PixelSampleList> asShareColumns(const std::vector<PixelSampleList>& pixels, int shares, int drawn,
+                                            const std::function<float(int, size_t)>& shareFactor) {
+  std::vector<PixelSampleList> out = pixels;
+  for (PixelSampleList& pixel : out)
+    for (size_t i = 0; i < pixel.size(); ++i) {
+      Sample& s = pixel[i];
+      std::vector<float> pdf;
+      for (int share = 0; share < shares; ++share) pdf.push_back(s.pdf[0] * shareFactor(share, i));
+      pdf.push_back(s.pdf[1]);
+      s.pdf = pdf;
+      s.technique = s.technique == 0 ? drawn : shares;
+    }
+  return out;
+}
+
+void checkSameSelection(const GridSearchResult& a, const GridSearchResult& b) {
+  CHECK(a.selected == b.selected);
+  CHECK(a.skipped == b.skipped);
+  CHECK(a.varianceRatio == b.varianceRatio);
+  for (size_t p = 0; p < a.allocations.size(); ++p) CHECK(a.allocations[p].alpha == b.allocations[p].alpha);
+}
+
+// With the optimal pdf's bank, rule (b) weighs each α_0 with the share a stage of that
+// α_0 samples with. Where every share has the same pdf, that is the search over the
+// techniques, bit for bit; where they differ, the kernel still selects as its reference,
+// and the selection follows the shares' pdfs.
+TEST_CASE("with share columns each combination is judged by its own share's pdf", "[exact][optimal]") {
+  const int width = 12, height = 10, shares = 3;
+  const std::vector<double> costs{1.5, 1.0};
+  const PooledSelection pooling{width, height, 2, 0.02};
+  const std::vector<PixelSampleList> pixels = randomPixels(2, width * height, 60, 23);
+  const SampleColumns columns(2, shares);
+  REQUIRE(columns.count() == 4);
+  const int drawn = kern::bankShareOf(shares, 0.5f);
+  auto same = [](int, size_t) { return 1.0f; };
+  BothResults techniques = searchBoth(pixels, 2, costs, GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
+  BothResults equalShares = searchBoth(asShareColumns(pixels, shares, drawn, same), columns, costs,
+                                       GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
+  checkSameSelection(equalShares.device, techniques.device);
+  checkSameSelection(equalShares.reference, techniques.reference);
+  // The share of small α_0 has twice the drawn pdf at every sample, that of large α_0 half:
+  // small α_0 then need half the samples' f²/p_α, large ones twice.
+  auto skewed = [&](int share, size_t) { return share < drawn ? 2.0f : (share > drawn ? 0.5f : 1.0f); };
+  BothResults skewedShares = searchBoth(asShareColumns(pixels, shares, drawn, skewed), columns, costs,
+                                        GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
+  checkSameSelection(skewedShares.device, skewedShares.reference);
+  double before = 0, after = 0;
+  for (int p = 0; p < width * height; ++p) {
+    before += techniques.reference.allocations[p].alpha[0];
+    after += skewedShares.reference.allocations[p].alpha[0];
+  }
+  CHECK(after < before);
+  // Rule (a) ranks each column by its own samples, which a share not drawn has none of.
+  StoredSampleLayout layout = layoutOf(pixels, columns, 60);
+  std::vector<float> samples = store(asShareColumns(pixels, shares, drawn, same), layout);
+  CHECK_THROWS_AS(GridSearchReference(columns, width * height).run(samples, layout, costs, GridRule::MaxEntropy),
+                  std::invalid_argument);
 }

@@ -4,10 +4,12 @@
 
 #include <catch2/catch.hpp>
 #include <cstring>
+#include <memory>
 
 #include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "alloc/GridSearch.h"
 #include "sampling/HostSampler.h"
 
 using namespace misalloc;
@@ -30,6 +32,7 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler
       {Estimator::OneSample, 0, 0},
       {Estimator::CountIndependent, MA_STATS_BALANCE, 0},
       {Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 100},
+      {Estimator::MultiSample, 0, 100, kDefaultGridSize, false, true},  // share columns with the optimal pdf
   };
   for (const char* pdf : {"plain", "optimal"}) {
     for (bool split : {false, true}) {
@@ -72,6 +75,57 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler
         }
       }
     }
+  }
+}
+
+// With share columns, a stored sample holds the envmap's pdf under each of the bank's
+// shares; the share its stage drew with must hold exactly the pdf the sample was
+// weighted with, and the rest of the record must be what a sampler without them stores.
+TEST_CASE("a stored sample's share columns hold the pdf of each share, its own share's as it was weighted",
+          "[sampler][optimal]") {
+  const Scene scene = smallScene("venice_sunset", "seed000", 24, 16, false, EnvmapSampler::Alias, 0, "optimal");
+  const int shares = scene.tables.bankShares, N = 40;
+  REQUIRE(shares == 3);
+  SamplerConfig techniques{Estimator::MultiSample, 0, N}, withShares = techniques;
+  withShares.shareColumns = true;
+  REQUIRE(sampleColumns(scene, withShares).count() == shares + 1);
+  StagePlan plan = singleStagePlan(scene, Method::Equal, N);
+  // Envmap counts 4 … 36 of 40: α_0 from 0.1 to 0.9, every share.
+  for (int p = 0; p < scene.pixelCount(); ++p) {
+    plan.counts[2 * p] = 4 + (p * 5) % 33;
+    plan.counts[2 * p + 1] = N - plan.counts[2 * p];
+  }
+  for (bool device : {false, true}) {
+    std::unique_ptr<StageSampler> a, b;
+    if (device) {
+      a = std::make_unique<Sampler>(testDevice(), scene, techniques);
+      b = std::make_unique<Sampler>(testDevice(), scene, withShares);
+    } else {
+      a = std::make_unique<HostSampler>(scene, techniques);
+      b = std::make_unique<HostSampler>(scene, withShares);
+    }
+    a->run(plan, 7);
+    b->run(plan, 7);
+    const std::vector<float> plain = a->storedSamples(), columns = b->storedSamples();
+    size_t mismatches = 0, otherShareDiffers = 0;
+    std::vector<int> sharesSeen(shares, 0);
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      const int share = kern::bankShareOf(shares, float(plan.counts[2 * p]) / float(N));
+      sharesSeen[share] = 1;
+      for (int i = 0; i < N; ++i) {
+        auto at = [&](const std::vector<float>& s, int q, int c) { return s[kern::storedSampleIndex(p, i, q, N, c)]; };
+        const int technique = int(at(plain, 0, 2));
+        mismatches += at(columns, 0, 4) != float(technique == 0 ? share : shares);
+        mismatches += at(columns, 1, 4) != at(plain, 1, 2);
+        mismatches += at(columns, 2 + share, 4) != at(plain, 2, 2);
+        mismatches += at(columns, 2 + shares, 4) != at(plain, 3, 2);
+        for (int s = 0; s < shares; ++s) otherShareDiffers += s != share && at(columns, 2 + s, 4) != at(plain, 2, 2);
+      }
+    }
+    INFO(fmt::format("device {}", device));
+    CHECK(mismatches == 0);
+    CHECK(sharesSeen == std::vector<int>(shares, 1));
+    CHECK(otherShareDiffers > 0);  // the shares' tables differ: the columns are not copies
   }
 }
 

@@ -31,16 +31,16 @@ constexpr int kPass = 16 * kGridVectors;
 constexpr int kLocalSize = 4;
 constexpr int kPoolLocalSize = 8;  // selectPooled: one work-item per pixel
 
-void checkTechniqueCount(int techniqueCount) {
-  if (techniqueCount < 2 || techniqueCount > kMaxTechniques)
-    throw std::invalid_argument(
-        fmt::format("grid search: {} techniques; it needs 2 to {}", techniqueCount, kMaxTechniques));
+void checkColumns(SampleColumns columns) {
+  if (columns.techniqueCount < 2 || columns.count() > kMaxTechniques || columns.shareColumns < 0)
+    throw std::invalid_argument(fmt::format("grid search: {} techniques in {} columns; it needs 2 to {}",
+                                            columns.techniqueCount, columns.count(), kMaxTechniques));
 }
 
-void checkLayout(const StoredSampleLayout& layout, int techniqueCount, int pixelCount, std::size_t availableFloats) {
-  if (layout.techniqueCount != techniqueCount)
-    throw std::invalid_argument(fmt::format("grid search: samples of {} techniques, search built for {}",
-                                            layout.techniqueCount, techniqueCount));
+void checkLayout(const StoredSampleLayout& layout, SampleColumns columns, int pixelCount, std::size_t availableFloats) {
+  if (layout.columns != columns.count())
+    throw std::invalid_argument(fmt::format("grid search: samples of {} columns, search built for {}",
+                                            layout.columns, columns.count()));
   if (layout.pixelCount != pixelCount)
     throw std::invalid_argument(
         fmt::format("grid search: samples of {} pixels, search built for {}", layout.pixelCount, pixelCount));
@@ -85,22 +85,22 @@ int paddedGridSize(int gridSize) { return (gridSize + kPass - 1) / kPass * kPass
 // Floats of running sums per pixel: Σ g and Σ g² for every technique and combination
 // of the grid makeWeightGrid makes (and validates), padded to whole passes.
 // The grid's combinations (not its costs): makeWeightGrid with unit costs.
-WeightGrid gridFor(int techniqueCount, int gridSize) {
-  return makeWeightGrid(techniqueCount, gridSize, std::vector<double>(techniqueCount, 1.0));
+WeightGrid gridFor(SampleColumns columns, int gridSize) {
+  return makeWeightGrid(columns, gridSize, std::vector<double>(columns.techniqueCount, 1.0));
 }
 
-std::size_t runningSumFloats(int techniqueCount, int gridSize) {
-  return std::size_t(2) * techniqueCount * paddedGridSize(gridFor(techniqueCount, gridSize).size());
+std::size_t runningSumFloats(SampleColumns columns, int gridSize) {
+  return std::size_t(2) * columns.count() * paddedGridSize(gridFor(columns, gridSize).size());
 }
 
 // The grid's combination nearest to α_k = 1/M, against which the skip rule weighs.
 int nearestEqual(const WeightGrid& grid) {
-  const int m = grid.techniqueCount;
+  const int m = grid.columns.techniqueCount;
   int best = 0;
   double bestDistance = INFINITY;
   for (int l = 0; l < grid.size(); ++l) {
     double d = 0;
-    for (int k = 0; k < m; ++k) d += (grid.alpha[l * m + k] - 1.0 / m) * (grid.alpha[l * m + k] - 1.0 / m);
+    for (int k = 0; k < m; ++k) d += (grid.techniqueWeight(l, k) - 1.0 / m) * (grid.techniqueWeight(l, k) - 1.0 / m);
     if (d < bestDistance) bestDistance = d, best = l;
   }
   return best;
@@ -110,6 +110,13 @@ int nearestEqual(const WeightGrid& grid) {
 void checkRunningSums(bool runningSums, bool added) {
   if (!runningSums && added)
     throw std::logic_error("grid search: a second search since reset() on a search that keeps no running sums");
+}
+
+// Rule (a) ranks each column by its own samples' sums; a share column that the stage
+// did not sample with has none.
+void checkRule(GridRule rule, SampleColumns columns) {
+  if (rule == GridRule::MaxEntropy && columns.shareColumns > 0)
+    throw std::invalid_argument("grid search: rule (a) on samples with share columns");
 }
 
 void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, int pixelCount) {
@@ -122,7 +129,7 @@ void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, 
                                             pixelCount));
 }
 
-// Per pixel α (M floats), l₀ and fallback bits, as the kernels write them.
+// Per pixel α (a float per column), l₀ and fallback bits, as the kernels write them.
 struct SelectionArrays {
   std::vector<float> alpha;
   std::vector<int> selected;
@@ -131,17 +138,21 @@ struct SelectionArrays {
   std::vector<float> varianceRatio;
 };
 
-GridSearchResult toResult(const SelectionArrays& a, int m) {
+// The allocations per technique: a technique's weight is the sum of its columns'; a
+// pixel that skipped takes α_k = 1/M (the kernels write 1/C per column).
+GridSearchResult toResult(const SelectionArrays& a, SampleColumns columns) {
   const std::size_t pixels = a.selected.size();
+  const int m = columns.techniqueCount, c = columns.count();
   GridSearchResult result;
   result.selected = a.selected;
   result.skipped = a.skipped;
   result.varianceRatio = a.varianceRatio;
   result.allocations.reserve(pixels);
   for (std::size_t p = 0; p < pixels; ++p) {
-    const float* weights = &a.alpha[p * m];
-    result.allocations.push_back(a.fallbacks[p] != 0 ? equalFallback(m, a.fallbacks[p])
-                                                     : Allocation{std::vector<double>(weights, weights + m)});
+    std::vector<double> alpha(m, 0.0);
+    for (int column = 0; column < c; ++column) alpha[columns.techniqueOf(column)] += a.alpha[p * c + column];
+    if (a.skipped[p]) alpha.assign(m, 1.0f / m);
+    result.allocations.push_back(a.fallbacks[p] != 0 ? equalFallback(m, a.fallbacks[p]) : Allocation{alpha});
   }
   return result;
 }
@@ -155,7 +166,7 @@ struct LaneGrid {
 };
 
 LaneGrid laneGrid(const WeightGrid& grid) {
-  const int m = grid.techniqueCount, u = grid.size();
+  const int m = grid.columns.count(), u = grid.size();
   LaneGrid lanes{paddedGridSize(u), {}, {}};
   lanes.alpha.resize(std::size_t(m) * lanes.paddedSize);
   lanes.cost.resize(lanes.paddedSize);
@@ -254,7 +265,7 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
 
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
               float* sums) {
-  switch (setup.layout.techniqueCount) {
+  switch (setup.layout.columns) {
     case 2:
       return sumPixel<2>(setup, added, prepared, rescale, sums);
     case 3:
@@ -267,7 +278,7 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
 // The best l₀ by the pixel's sums ([HS14] Alg. 1 line 13), −1 if none could be ranked;
 // every combination's score goes to `scores`.
 int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, const float* sums, float* scores) {
-  const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
+  const int m = setup.layout.columns, padded = setup.lanes.paddedSize;
   float invCount[kMaxTechniques], bestScore = -INFINITY;
   for (int j = 0; j < m; ++j) invCount[j] = 1.0f / all.count[j];
   const float invTotal = 1.0f / kern::sampleCount(m, all);
@@ -294,10 +305,11 @@ int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, con
 // scores and the scale of the sums.
 void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepared, kern::PixelSummary& summary,
                  float* sums, SelectionArrays& out, float* scores, float& scale) {
-  const int m = setup.layout.techniqueCount;
+  const int m = setup.layout.columns;
   const float* pixelSamples = setup.samples + kern::storedSampleIndex(pixel, 0, 0, setup.layout.capacity, m);
   kern::PixelSummary added = kern::emptySummary();
-  for (int i = 0; i < setup.layout.taken; ++i) kern::summariseSample(&added, pixelSamples, m, i);
+  for (int i = 0; i < setup.layout.taken; ++i)
+    kern::summariseSample(&added, pixelSamples, m, setup.grid.columns.shareColumns, i);
   const kern::PixelSummary all = kern::mergeSummaries(summary, added);
   unsigned fallbacks = kern::pixelFallbacks(m, all, setup.rule);
   int best = -1;
@@ -341,7 +353,7 @@ float pooledScore(const std::vector<float>& scores, const std::vector<float>& sc
 void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling, int equal,
                        const std::vector<float>& scores, const std::vector<float>& scales, const SelectionArrays& in,
                        int pixel, SelectionArrays& out) {
-  const int m = setup.layout.techniqueCount, padded = setup.lanes.paddedSize;
+  const int m = setup.layout.columns, padded = setup.lanes.paddedSize;
   kern::PoolWindow w = kern::poolWindow(pixel, pooling.width, pooling.height, pooling.radius);
   float scaleMin = INFINITY;
   for (int y = w.y0; y <= w.y1; ++y)
@@ -389,30 +401,47 @@ SelectionArrays selectionArrays(int pixels, int m) {
 
 }  // namespace
 
-WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::vector<double>& costs) {
-  checkTechniqueCount(techniqueCount);
-  validateCosts(costs, techniqueCount);
+double WeightGrid::techniqueWeight(int l, int k) const {
+  double weight = 0;
+  for (int column = 0; column < columns.count(); ++column)
+    if (columns.techniqueOf(column) == k) weight += alpha[std::size_t(l) * columns.count() + column];
+  return weight;
+}
+
+WeightGrid makeWeightGrid(SampleColumns columns, int approximateSize, const std::vector<double>& costs) {
+  checkColumns(columns);
+  const int m = columns.techniqueCount, c = columns.count();
+  validateCosts(costs, m);
   if (approximateSize < 1) throw std::invalid_argument("grid search: the grid needs at least one combination");
-  int resolution = closestResolution(techniqueCount, approximateSize);
+  int resolution = closestResolution(m, approximateSize);
+  std::vector<float> lattice;
+  std::vector<int> a(m);
+  appendLattice(a, 0, resolution, resolution, lattice);
   WeightGrid grid;
-  grid.techniqueCount = techniqueCount;
-  std::vector<int> a(techniqueCount);
-  appendLattice(a, 0, resolution, resolution, grid.alpha);
-  for (std::size_t l = 0; l < grid.alpha.size() / techniqueCount; ++l) {
+  grid.columns = columns;
+  for (std::size_t l = 0; l < lattice.size() / m; ++l) {
+    const float* alpha = &lattice[l * m];
+    // Technique 0's weight in its share's column where there are share columns.
+    const int envmapColumn = columns.shareColumns > 0 ? kern::bankShareOf(columns.shareColumns, alpha[0]) : 0;
     double meanCost = 0;
-    for (int k = 0; k < techniqueCount; ++k) meanCost += costs[k] * grid.alpha[l * techniqueCount + k];
+    for (int column = 0; column < c; ++column) {
+      const int k = columns.techniqueOf(column);
+      grid.alpha.push_back(k == 0 && column != envmapColumn ? 0.0f : alpha[k]);
+    }
+    for (int k = 0; k < m; ++k) meanCost += costs[k] * alpha[k];
     grid.cost.push_back(float(meanCost));
   }
   return grid;
 }
 
-std::string gridSearchKernelOptions(int techniqueCount) {
-  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_GRID_VECTORS={}", techniqueCount, kGridVectors);
+std::string gridSearchKernelOptions(SampleColumns columns) {
+  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SHARE_COLUMNS={} -DMA_GRID_VECTORS={}", columns.count(),
+                     columns.shareColumns, kGridVectors);
 }
 
-std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums) {
-  const std::size_t scoreFloats = paddedGridSize(gridFor(techniqueCount, gridSize).size()) + 1;  // and the scale
-  const std::size_t sumFloats = runningSums ? runningSumFloats(techniqueCount, gridSize) : 0;
+std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums) {
+  const std::size_t scoreFloats = paddedGridSize(gridFor(columns, gridSize).size()) + 1;  // and the scale
+  const std::size_t sumFloats = runningSums ? runningSumFloats(columns, gridSize) : 0;
   return (sumFloats + scoreFloats) * sizeof(float) + sizeof(kern::PixelSummary);
 }
 
@@ -421,13 +450,10 @@ int GridSearchResult::fallbackCount() const {
       std::count_if(allocations.begin(), allocations.end(), [](const Allocation& a) { return a.usedFallback(); }));
 }
 
-GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize, bool runningSums)
-    : device_(device),
-      techniqueCount_(techniqueCount),
-      pixelCount_(pixelCount),
-      gridSize_(gridSize),
-      runningSums_(runningSums) {
-  cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(techniqueCount));
+GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize, bool runningSums)
+    : device_(device), columns_(columns), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
+  checkColumns(columns);
+  cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(columns));
   kernel_ = cl::Kernel(program, "gridSearch");
   poolKernel_ = cl::Kernel(program, "selectPooled");
   // OpenCL buffers cannot be empty.
@@ -436,10 +462,10 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
   // Only pixels with hasSums read their sums, so reset() leaves them; they are written
   // once here so that the first search does not pay a page fault per 4 KiB of them.
   // Without running sums the kernel reads and writes none: one float stands in.
-  const std::size_t sumBytes = (runningSums ? pixels * runningSumFloats(techniqueCount, gridSize) : 1) * sizeof(float);
+  const std::size_t sumBytes = (runningSums ? pixels * runningSumFloats(columns, gridSize) : 1) * sizeof(float);
   sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
   device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
-  const std::size_t scoreBytes = pixels * paddedGridSize(gridFor(techniqueCount, gridSize).size()) * sizeof(float);
+  const std::size_t scoreBytes = pixels * paddedGridSize(gridFor(columns, gridSize).size()) * sizeof(float);
   scores_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, scoreBytes);
   device.queue.enqueueFillBuffer(scores_, cl_uchar(0), 0, scoreBytes);
   scales_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(float));
@@ -447,8 +473,8 @@ GridSearch::GridSearch(const Device& device, int techniqueCount, int pixelCount,
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a search of no samples, not inside the first timed one.
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
-  run(noSamples, StoredSampleLayout{pixelCount, techniqueCount, 0, 0}, std::vector<double>(techniqueCount, 1.0),
-      GridRule::MinCostVariance, PooledSelection{pixelCount, 1, 0, 0});
+  run(noSamples, StoredSampleLayout{pixelCount, columns.count(), 0, 0},
+      std::vector<double>(columns.techniqueCount, 1.0), GridRule::MinCostVariance, PooledSelection{pixelCount, 1, 0, 0});
 }
 
 void GridSearch::reset() {
@@ -461,12 +487,13 @@ void GridSearch::reset() {
 GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLayout& layout,
                                  const std::vector<double>& costs, GridRule rule,
                                  const std::optional<PooledSelection>& pooling) {
-  checkLayout(layout, techniqueCount_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
+  checkLayout(layout, columns_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
+  checkRule(rule, columns_);
   checkPooling(pooling, rule, pixelCount_);
   checkRunningSums(runningSums_, added_);
   added_ = added_ || layout.taken > 0;
-  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
-  const int m = techniqueCount_, pixels = layout.pixelCount;
+  WeightGrid grid = makeWeightGrid(columns_, gridSize_, costs);
+  const int m = columns_.count(), pixels = layout.pixelCount;
   GridSearchResult result;
   if (pixels == 0) return result;
   auto upload = [&](std::vector<float> data) {
@@ -522,7 +549,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   device_.queue.enqueueReadBuffer(selectedFinal, CL_FALSE, 0, pixels * sizeof(cl_int), out.selected.data());
   device_.queue.enqueueReadBuffer(fallbacksFinal, CL_TRUE, 0, pixels * sizeof(cl_uint), out.fallbacks.data());
   double seconds = result.seconds;
-  result = toResult(out, m);
+  result = toResult(out, columns_);
   result.seconds = seconds;
   return result;
 }
@@ -534,11 +561,12 @@ struct GridSearchReference::RunningSums {
   std::vector<float> scores, scales;  // the last search's, as the kernel keeps them
 };
 
-GridSearchReference::GridSearchReference(int techniqueCount, int pixelCount, int gridSize, bool runningSums)
-    : techniqueCount_(techniqueCount), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
+GridSearchReference::GridSearchReference(SampleColumns columns, int pixelCount, int gridSize, bool runningSums)
+    : columns_(columns), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
+  checkColumns(columns);
   running_ = std::make_unique<RunningSums>();
   if (runningSums)
-    running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(techniqueCount, gridSize));
+    running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(columns, gridSize));
   reset();
 }
 
@@ -552,13 +580,14 @@ void GridSearchReference::reset() {
 GridSearchResult GridSearchReference::run(const std::vector<float>& samples, const StoredSampleLayout& layout,
                                           const std::vector<double>& costs, GridRule rule,
                                           const std::optional<PooledSelection>& pooling) {
-  checkLayout(layout, techniqueCount_, pixelCount_, samples.size());
+  checkLayout(layout, columns_, pixelCount_, samples.size());
+  checkRule(rule, columns_);
   checkPooling(pooling, rule, pixelCount_);
   checkRunningSums(runningSums_, added_);
   added_ = added_ || layout.taken > 0;
-  WeightGrid grid = makeWeightGrid(techniqueCount_, gridSize_, costs);
+  WeightGrid grid = makeWeightGrid(columns_, gridSize_, costs);
   SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
-  const int m = techniqueCount_, pixels = layout.pixelCount, padded = setup.lanes.paddedSize;
+  const int m = columns_.count(), pixels = layout.pixelCount, padded = setup.lanes.paddedSize;
   const std::size_t pixelSums = std::size_t(2) * m * padded;
   std::vector<float>& scores = running_->scores;
   std::vector<float>& scales = running_->scales;
@@ -583,7 +612,7 @@ GridSearchResult GridSearchReference::run(const std::vector<float>& samples, con
     for (int pixel = 0; pixel < pixels; ++pixel)
       selectPooledPixel(setup, *pooling, equal, scores, scales, searched, pixel, selection);
   }
-  GridSearchResult result = toResult(selection, m);
+  GridSearchResult result = toResult(selection, columns_);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -35,28 +35,34 @@ inline constexpr int kDefaultGridSize = 80;
 // The U weight combinations of [HS14] Alg. 1 line 4, every α_k > 0. For a lattice
 // resolution r they are α_k = (a_k + 1/M) / (r + 1) over the integer a ≥ 0 with
 // Σ_k a_k = r: C(r + M − 1, M − 1) points, r chosen to make that closest to the
-// requested size (exactly U for M = 2, where α_0 = (l + ½)/U).
+// requested size (exactly U for M = 2, where α_0 = (l + ½)/U). The search weighs the
+// stored samples' columns (SampleColumns): with share columns, a combination puts α_0
+// in the column of the share that a stage of that α_0 samples with (bankShareOf,
+// kernels/envmap.h) and 0 in the other shares', so that each α_0 is judged by the pdf
+// it would run.
 struct WeightGrid {
-  int techniqueCount = 0;
-  std::vector<float> alpha;  // [l·M + k]
+  SampleColumns columns{0};
+  std::vector<float> alpha;  // [l·C + c]: the weight of column c
   std::vector<float> cost;   // [l]: Σ_k c_k α_{k,l}, the cost per sample at l
 
   int size() const { return static_cast<int>(cost.size()); }
+  // α_k of combination l: the sum of technique k's columns.
+  double techniqueWeight(int l, int k) const;
 };
 
-// Throws std::invalid_argument for M outside 2..kMaxTechniques, a size < 1 or an
-// invalid cost (validateCosts).
-WeightGrid makeWeightGrid(int techniqueCount, int approximateSize, const std::vector<double>& costs);
+// Throws std::invalid_argument for M outside 2..kMaxTechniques, columns beyond it, a
+// size < 1 or an invalid cost (validateCosts; one per technique).
+WeightGrid makeWeightGrid(SampleColumns columns, int approximateSize, const std::vector<double>& costs);
 
-// The `-D` options that compile kernels/gridsearch.cl for M techniques. The grid, its
+// The `-D` options that compile kernels/gridsearch.cl for these columns. The grid, its
 // rule and the pooling are kernel arguments: one program serves them all.
-std::string gridSearchKernelOptions(int techniqueCount);
+std::string gridSearchKernelOptions(SampleColumns columns);
 
-// What a search keeps per pixel from run to run: Σ g and Σ g² for every technique and
+// What a search keeps per pixel from run to run: Σ g and Σ g² for every column and
 // combination (the grid padded to whole passes) where it keeps running sums, the
 // summary of the samples, and the last search's scores and scale for the pooled
 // selection.
-std::size_t gridSearchBytesPerPixel(int techniqueCount, int gridSize, bool runningSums);
+std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums);
 
 // Rule (b)'s selection over neighbourhoods (Pooling.h says why) and the skip
 // rule, for the pixels of a width × height image: each pixel takes the combination
@@ -86,24 +92,25 @@ struct GridSearchResult {
   int fallbackCount() const;
 };
 
-// Runs kernels/gridsearch.cl for `pixelCount` pixels over makeWeightGrid(techniqueCount,
+// Runs kernels/gridsearch.cl for `pixelCount` pixels over makeWeightGrid(columns,
 // gridSize, ·); the program is built and its first launch compiled once. Each run adds
 // the samples stored since the previous one to every pixel's running sums
 // (gridSearchBytesPerPixel, on the device) and selects by all the samples added so far.
 // Without `runningSums` (a render with one search) nothing is kept, which saves their
 // memory and the search the time of writing them, and a second search with samples
 // since reset() throws std::logic_error.
-// A scratch buffer of taken · (M + 1) floats per pixel, for the new samples as the sums
-// read them, is kept from run to run.
+// A scratch buffer of taken · (C + 1) floats per pixel, for the new samples as the sums
+// read them, is kept from run to run. The allocations it returns are per technique.
 class GridSearch {
  public:
-  // Throws std::invalid_argument for M outside 2..kMaxTechniques or a grid size < 1.
-  GridSearch(const Device& device, int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize,
+  // Throws std::invalid_argument for columns that makeWeightGrid rejects or a grid size < 1.
+  GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize,
              bool runningSums = true);
 
-  // Throws std::invalid_argument for a layout that does not match M, the pixel count
-  // or the buffer, taken > capacity, costs that makeWeightGrid rejects, or pooling
-  // with rule (a) or an image that does not match the pixel count.
+  // Throws std::invalid_argument for a layout that does not match the columns, the
+  // pixel count or the buffer, taken > capacity, costs that makeWeightGrid rejects,
+  // rule (a) with share columns (it ranks each column by its own samples), or pooling
+  // with rule (a) or over an image that does not match the pixel count.
   GridSearchResult run(const cl::Buffer& samples, const StoredSampleLayout& layout, const std::vector<double>& costs,
                        GridRule rule = GridRule::MinCostVariance,
                        const std::optional<PooledSelection>& pooling = std::nullopt);
@@ -112,7 +119,8 @@ class GridSearch {
 
  private:
   const Device& device_;
-  int techniqueCount_, pixelCount_, gridSize_;
+  SampleColumns columns_;
+  int pixelCount_, gridSize_;
   bool runningSums_;
   bool added_ = false;  // a search since reset() added samples
   cl::Kernel kernel_, poolKernel_;
@@ -125,7 +133,7 @@ class GridSearch {
 // running sums in host memory.
 class GridSearchReference {
  public:
-  GridSearchReference(int techniqueCount, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true);
+  GridSearchReference(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true);
   ~GridSearchReference();
 
   GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
@@ -135,7 +143,8 @@ class GridSearchReference {
 
  private:
   struct RunningSums;  // kernels/gridsearch.h's types, which this header does not include
-  int techniqueCount_, pixelCount_, gridSize_;
+  SampleColumns columns_;
+  int pixelCount_, gridSize_;
   bool runningSums_;
   bool added_ = false;
   std::unique_ptr<RunningSums> running_;

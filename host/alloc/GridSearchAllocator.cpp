@@ -29,15 +29,15 @@ KeptGridSearch& keptSearch(StageStatistics& stages) {
   auto kept = std::make_unique<KeptGridSearch>();
   if (const Device* device = stages.storedSampleDevice()) {
     try {
-      kept->device = std::make_unique<GridSearch>(*device, scene.techniqueCount(), scene.pixelCount(), config.gridSize,
-                                                  config.runningSums);
+      kept->device = std::make_unique<GridSearch>(*device, sampleColumns(scene, config), scene.pixelCount(),
+                                                  config.gridSize, config.runningSums);
     } catch (const cl::Error& e) {
       // The grid's sums and scores are the search's largest buffers.
       throw explainBufferError(e, *device, fmt::format("--grid-u {}", config.gridSize), scene.pixelCount());
     }
   } else {
-    kept->host = std::make_unique<GridSearchReference>(scene.techniqueCount(), scene.pixelCount(), config.gridSize,
-                                                       config.runningSums);
+    kept->host = std::make_unique<GridSearchReference>(sampleColumns(scene, config), scene.pixelCount(),
+                                                       config.gridSize, config.runningSums);
   }
   stages.kept() = std::move(kept);
   return static_cast<KeptGridSearch&>(*stages.kept());
@@ -51,7 +51,7 @@ GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, GridRule rule,
   if (config.gridSize <= 0 || config.sampleCapacity <= 0)
     throw std::logic_error("grid search on a sampler that does not keep what it needs");
   keptSearch(stages).reset();
-  bytesPerPixel_ = gridSearchBytesPerPixel(stages.scene().techniqueCount(), config.gridSize, config.runningSums);
+  bytesPerPixel_ = gridSearchBytesPerPixel(sampleColumns(stages.scene(), config), config.gridSize, config.runningSums);
 }
 
 StageAllocation GridSearchAllocator::allocate(StageStatistics& stages, const std::vector<double>& costs) {

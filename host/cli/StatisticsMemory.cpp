@@ -4,6 +4,7 @@
 
 #include "KernelCode.h"
 #include "MemoryBudget.h"
+#include "distributions/OptimalBank.h"
 
 namespace misalloc {
 namespace {
@@ -18,13 +19,17 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
                             const std::string& sppOption, int spp, const AdaptiveOptions& adaptive, bool onHost,
                             int samplers) {
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
-  const double pixels = double(scene.width) * scene.height, M = scene.techniqueCount();
+  const double pixels = double(scene.width) * scene.height;
+  // The columns of an optimal pdf's bank of every share (sampleColumns), from the
+  // options alone: at most what the scene's tables give.
+  const int shares = config.shareColumns && scene.envmapPdf.optimal() ? OptimalBankOptions{}.shares : 0;
+  const double C = MA_STORED_COLUMNS(scene.techniqueCount(), shares);
   if (config.sampleCapacity > 0) {
     // A record per sample (kernels/stats.h), on a CPU device once in its buffer and
     // once read back; with several devices, once in each device's buffer, once
     // gathered on the host and once read back.
     const int copies = samplers > 1 ? samplers + 2 : 2;
-    const double recordBytes = MA_SAMPLE_RECORD_FLOATS(scene.techniqueCount()) * sizeof(float);
+    const double recordBytes = MA_SAMPLE_RECORD_FLOATS(int(C)) * sizeof(float);
     const double perPixel = double(config.sampleCapacity) * recordBytes * copies;
     std::string option = fmt::format("{} {}", sppOption, spp);
     if (methodTraits(m).split == Split::Probed) option += fmt::format(" and --oracle-spp {}", adaptive.oracleSamples);
@@ -33,17 +38,17 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
                      pixels * perPixel});
   }
   if (config.gridSize > 0) {
-    // The weight grid, M weights and a cost per combination, is built on the host; the
-    // running sums, Σ g and Σ g² per technique and combination, too on the C++ device
+    // The weight grid, a weight per column and a cost per combination, is built on the
+    // host; the running sums, Σ g and Σ g² per column and combination, too on the C++ device
     // where a render searches more than once (alloc/GridSearch.h). Both from the
     // options alone: building the grid to size it would be the allocation this check
     // prevents.
-    const double U = config.gridSize, gridBytes = U * (M + 1) * sizeof(float);
-    const double sumBytes = onHost && config.runningSums ? pixels * 2 * M * U * sizeof(float) : 0;
+    const double U = config.gridSize, gridBytes = U * (C + 1) * sizeof(float);
+    const double sumBytes = onHost && config.runningSums ? pixels * 2 * C * U * sizeof(float) : 0;
     needs.push_back(
         {fmt::format(
-             "--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U, (M + 1) * sizeof(float),
-             sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, 2 * M * U * sizeof(float)) : ""),
+             "--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U, (C + 1) * sizeof(float),
+             sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, 2 * C * U * sizeof(float)) : ""),
          gridBytes + sumBytes});
   }
 }

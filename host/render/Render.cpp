@@ -162,6 +162,8 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
         traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp);
     config.gridSize = options.gridSize;
     config.runningSums = traits.split == Split::Staged && options.stages > 1;
+    // Rule (b) judges each α_0 by the pdf of the share it would run (WeightGrid).
+    config.shareColumns = traits.split == Split::Probed || options.gridRule == GridRule::MinCostVariance;
   }
   return config;
 }

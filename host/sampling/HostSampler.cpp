@@ -31,7 +31,7 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
 HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
   share_.name = kHostSamplerName;
-  if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config.sampleCapacity);
+  if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config);
 }
 
 void HostSampler::forgetStages() {
@@ -47,6 +47,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
   ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
   const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
+  const SampleColumns columns = sampleColumns(scene_, config);
+  ts.sharePdfs = columns.shareColumns > 0 ? 1 : 0;
   const int slots = plan.keepStatistics ? statSlots() : 0;
   const int perTechnique = MA_STATS_PER_TECHNIQUE(int(config.statsMask), M);
   StageResult result;
@@ -76,10 +78,13 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
           running[slot] += kern::statValue(int(config.statsMask), slot % perTechnique, s);
       if (config.sampleCapacity > 0) {
         int i = firstSlot + j;
-        samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, M)] = float(s.technique);
-        samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, M)] = s.y;
-        for (int l = 0; l < M; ++l)
-          samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, M)] = s.pdfs[l];
+        const int C = columns.count();
+        samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, C)] =
+            float(kern::storedColumn(s, columns.shareColumns));
+        samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, C)] = s.y;
+        for (int l = 0; l < C; ++l)
+          samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, C)] =
+              kern::storedPdf(s, columns.shareColumns, l);
       }
     }
     const size_t row = size_t(pixel - range.begin);

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "Constants.h"
+#include "KernelCode.h"
 
 namespace misalloc {
 
@@ -61,6 +62,21 @@ struct SamplerConfig {
   int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
   // The grid searches keep running sums, for renders that search more than once.
   bool runningSums = true;
+  // The stored samples carry the envmap's pdf under every share of the optimal pdf's
+  // bank, where the scene has one (SampleColumns): for the grid search's rule (b).
+  bool shareColumns = false;
+};
+
+// The columns of a stored sample (kernels/stats.h): the pdfs an allocation weighs, one
+// per technique, or with share columns S > 0 the envmap's under each of the bank's S
+// shares, then the other techniques.
+struct SampleColumns {
+  int techniqueCount = 0;
+  int shareColumns = 0;
+
+  SampleColumns(int techniqueCount, int shareColumns = 0) : techniqueCount(techniqueCount), shareColumns(shareColumns) {}
+  int count() const { return MA_STORED_COLUMNS(techniqueCount, shareColumns); }
+  int techniqueOf(int column) const { return kern::techniqueOfColumn(column, shareColumns); }
 };
 
 // Where the stored samples are: the blocked float layout of kernels/stats.h
@@ -69,12 +85,13 @@ struct SamplerConfig {
 // samples as those taken since the previous search.
 struct StoredSampleLayout {
   int pixelCount = 0;
-  int techniqueCount = 0;
+  int columns = 0;  // SampleColumns::count
   int capacity = 0;
   int taken = 0;
 
   std::size_t floatCount() const {
-    return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) * std::size_t(techniqueCount + 2);
+    return paddedPixelCount(std::size_t(pixelCount)) * std::size_t(capacity) *
+           std::size_t(MA_SAMPLE_RECORD_FLOATS(columns));
   }
 };
 

@@ -19,7 +19,8 @@ int StageStatistics::statSlots() const {
 }
 
 size_t StageStatistics::storedSampleCount() const {
-  return StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, 0}.floatCount();
+  return StoredSampleLayout{scene_.pixelCount(), sampleColumns(scene_, config_).count(), config_.sampleCapacity, 0}
+      .floatCount();
 }
 
 int StageStatistics::takeSlots(const StagePlan& plan) {
@@ -44,17 +45,25 @@ void StageStatistics::forgetSlots() {
 StoredSamples StageStatistics::takeStoredSamples() {
   if (config_.sampleCapacity <= 0) throw std::logic_error("a search on a sampler that stores no samples");
   StoredSamples stored{
-      StoredSampleLayout{scene_.pixelCount(), scene_.techniqueCount(), config_.sampleCapacity, taken_ - searched_},
+      StoredSampleLayout{scene_.pixelCount(), sampleColumns(scene_, config_).count(), config_.sampleCapacity,
+                         taken_ - searched_},
       storedSampleBuffer()};
   searched_ = taken_;
   return stored;
 }
 
-std::vector<float> emptyStoredSamples(const Scene& scene, int capacity) {
-  const int M = scene.techniqueCount();
-  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), M, capacity, 0}.floatCount(), 1.0f);
+SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config) {
+  const int M = scene.techniqueCount(), shares = scene.tables.bankShares;
+  const bool fits = shares > 0 && shares <= MA_MAX_BANK_SHARES && MA_STORED_COLUMNS(M, shares) <= MA_GRID_MAX_TECHNIQUES;
+  return SampleColumns(M, config.shareColumns && fits ? shares : 0);
+}
+
+std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config) {
+  const int columns = sampleColumns(scene, config).count();
+  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), columns, config.sampleCapacity, 0}.floatCount(),
+                             1.0f);
   for (size_t record = 0; record < samples.size() / 16; ++record) {
-    int q = int(record % size_t(M + 2));
+    int q = int(record % size_t(MA_SAMPLE_RECORD_FLOATS(columns)));
     if (q < 2) std::fill_n(samples.begin() + record * 16, 16, 0.0f);
   }
   return samples;
@@ -66,6 +75,7 @@ SamplerConfig plainConfig(SamplerConfig config) {
   config.statsMask = 0;
   config.sampleCapacity = 0;
   config.gridSize = 0;
+  config.shareColumns = false;
   return config;
 }
 

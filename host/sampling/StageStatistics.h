@@ -90,8 +90,13 @@ class StageStatistics {
 bool keepsStatistics(const SamplerConfig& config);
 SamplerConfig plainConfig(SamplerConfig config);
 
-// Padding lanes of the stored samples: technique 0, f = 0 and every pdf 1, so that
-// the grid search may read them as samples that contribute nothing.
-std::vector<float> emptyStoredSamples(const Scene& scene, int capacity);
+// The columns of the samples that a sampler with this config stores for `scene`: share
+// columns where the config asks for them and the scene's envmap pdf has a bank whose
+// shares fit the grid search's columns.
+SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config);
+
+// Padding lanes of the stored samples: column 0, f = 0 and every pdf 1, so that the
+// grid search may read them as samples that contribute nothing.
+std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config);
 
 }  // namespace misalloc

@@ -22,8 +22,8 @@ double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 
 // The stored samples of the pixel blocks that `tile` covers: tiles start on a block
 // (TileQueue granularity kPixelBlock), so blocks are never shared between tiles.
-std::pair<size_t, size_t> storedSpan(PixelRange tile, int capacity, int techniqueCount) {
-  const size_t blockFloats = size_t(capacity) * size_t(techniqueCount + 2) * kPixelBlock;
+std::pair<size_t, size_t> storedSpan(PixelRange tile, int capacity, int columns) {
+  const size_t blockFloats = size_t(capacity) * size_t(MA_SAMPLE_RECORD_FLOATS(columns)) * kPixelBlock;
   const size_t firstBlock = size_t(tile.begin) / kPixelBlock;
   const size_t endBlock = (size_t(tile.end) + kPixelBlock - 1) / kPixelBlock;
   return {firstBlock * blockFloats, endBlock * blockFloats};
@@ -125,7 +125,7 @@ StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int fi
 }
 
 void TiledSampler::gatherStatistics(const std::vector<std::vector<PixelRange>>& ran) {
-  const int slots = statSlots(), M = scene_.techniqueCount();
+  const int slots = statSlots();
   for (size_t d = 0; d < members_.size(); ++d) {
     if (ran[d].empty()) continue;
     if (slots > 0) {
@@ -137,7 +137,7 @@ void TiledSampler::gatherStatistics(const std::vector<std::vector<PixelRange>>& 
     if (config_.sampleCapacity > 0) {
       const std::vector<float> samples = members_[d]->storedSamples();
       for (PixelRange t : ran[d]) {
-        auto [begin, end] = storedSpan(t, config_.sampleCapacity, M);
+        auto [begin, end] = storedSpan(t, config_.sampleCapacity, sampleColumns(scene_, config_).count());
         std::copy(samples.begin() + begin, samples.begin() + end, samples_.begin() + begin);
       }
     }
@@ -184,7 +184,7 @@ void TiledSampler::forgetStages() {
     if (live(d)) members_[d]->reset();
   loaded_.assign(members_.size(), 1);  // every member starts from zero sums, as stats_
   stats_.assign(size_t(scene_.pixelCount()) * statSlots(), 0.0);
-  samples_ = config_.sampleCapacity > 0 ? emptyStoredSamples(scene_, config_.sampleCapacity) : std::vector<float>{};
+  samples_ = config_.sampleCapacity > 0 ? emptyStoredSamples(scene_, config_) : std::vector<float>{};
   imbalanceSeconds_ = 0;
 }
 
