@@ -1,6 +1,6 @@
-// A sharded comparison: shards of whole scenes merged into the unsharded run's folder,
-// its images bit for bit and its errors to the digit (times excluded), and merge's
-// refusals of folders that do not make one run.
+// A sharded comparison: shards of whole scenes, or of (scene, repeat) pairs, merged into
+// the unsharded run's folder, its images bit for bit and its errors to the digit (times
+// excluded), and merge's refusals of folders that do not make one run.
 #include <fmt/format.h>
 
 #include <catch2/catch.hpp>
@@ -16,20 +16,24 @@ using namespace misalloc::test;
 
 namespace {
 
-std::string compareArgs(const fs::path& dir, const std::string& extra) {
+// The sweeps: the suite's scenes once each, or one scene three times.
+const std::string kSuite = "--suite --repeats 1", kRepeats = "--envmap sun --repeats 3";
+
+std::string compareArgs(const fs::path& dir, const std::string& sweep, const std::string& extra) {
   return fmt::format(
-      "compare --suite --size 8x8 --methods equal,exact --envmap-pdfs plain,compensated --budgets 16,24 --repeats 1 "
-      "--cost 1,1.5 --reference-spp 64 --device cpu --cache-dir {} {}",
-      (dir / "cache").string(), extra);
+      "compare {} --size 8x8 --methods equal,exact --envmap-pdfs plain,compensated --budgets 16,24 --cost 1,1.5 "
+      "--reference-spp 64 --device cpu --cache-dir {} {}",
+      sweep, (dir / "cache").string(), extra);
 }
 
 std::string shardPath(const fs::path& dir, int k) { return (dir / fmt::format("shard{}", k)).string(); }
 
 // Shards `ks` of `shards`.
-void runShards(const fs::path& dir, const std::string& extra, int shards, const std::vector<int>& ks) {
+void runShards(const fs::path& dir, const std::string& sweep, const std::string& extra, int shards,
+               const std::vector<int>& ks) {
   for (int k : ks) {
     auto r = runMisalloc(
-        compareArgs(dir, fmt::format("{} --shard {}/{} --out-dir {}", extra, k, shards, shardPath(dir, k))));
+        compareArgs(dir, sweep, fmt::format("{} --shard {}/{} --out-dir {}", extra, k, shards, shardPath(dir, k))));
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
   }
@@ -50,31 +54,37 @@ nlohmann::json withoutTimes(nlohmann::json run) {
   return run;
 }
 
-}  // namespace
-
-TEST_CASE("merged shards of a comparison are the unsharded run: images bit for bit, errors to the digit",
-          "[compare][shard][cli]") {
-  TempDir dir("compare_shard");
-  auto whole = runMisalloc(compareArgs(dir.path, "--out-dir " + (dir.path / "whole").string()));
+// Runs the sweep unsharded into dir/whole, and `shards` shards of it.
+void runWholeAndShards(const fs::path& dir, const std::string& sweep, const std::string& extra, int shards) {
+  auto whole = runMisalloc(compareArgs(dir, sweep, "--out-dir " + (dir / "whole").string()));
   INFO(whole.output);
   REQUIRE(whole.exitCode == 0);
-  runShards(dir.path, "", 3, {0, 1, 2});
-  const fs::path merged = dir.path / "merged";
-  auto m = runMisalloc(fmt::format("merge --out-dir {} {} {} {}", merged.string(), shardPath(dir.path, 2),
-                                   shardPath(dir.path, 0), shardPath(dir.path, 1)));
+  std::vector<int> ks(size_t(shards), 0);
+  for (int k = 0; k < shards; ++k) ks[size_t(k)] = k;
+  runShards(dir, sweep, extra, shards, ks);
+}
+
+// Merges `parts` into dir/merged and checks it against dir/whole: the same files, the
+// images bit for bit, every run's record but its times (its node included: one machine
+// here) and every case's repeats.
+void checkMergedIsWhole(const fs::path& dir, const std::vector<std::string>& parts) {
+  const fs::path merged = dir / "merged", whole = dir / "whole";
+  std::string args = "merge --out-dir " + merged.string();
+  for (const std::string& p : parts) args += " " + p;
+  auto m = runMisalloc(args);
   INFO(m.output);
   REQUIRE(m.exitCode == 0);
-  const std::set<std::string> files = filesUnder(dir.path / "whole");
+  const std::set<std::string> files = filesUnder(whole);
   CHECK(filesUnder(merged) == files);
   int images = 0;
   for (const std::string& f : files)
     if (f.size() > 4 && (f.substr(f.size() - 4) == ".exr" || f.substr(f.size() - 4) == ".png")) {
       INFO(f);
-      CHECK(readText(merged / f) == readText(dir.path / "whole" / f));
+      CHECK(readText(merged / f) == readText(whole / f));
       ++images;
     }
   CHECK(images > 0);
-  const auto wholeRuns = nlohmann::json::parse(readText(dir.path / "whole" / "runs.json"));
+  const auto wholeRuns = nlohmann::json::parse(readText(whole / "runs.json"));
   const auto mergedRuns = nlohmann::json::parse(readText(merged / "runs.json"));
   REQUIRE(mergedRuns["runs"].size() == wholeRuns["runs"].size());
   for (size_t i = 0; i < wholeRuns["runs"].size(); ++i)
@@ -82,14 +92,23 @@ TEST_CASE("merged shards of a comparison are the unsharded run: images bit for b
   REQUIRE(mergedRuns["cases"].size() == wholeRuns["cases"].size());
   for (size_t i = 0; i < wholeRuns["cases"].size(); ++i) {
     CHECK(mergedRuns["cases"][i]["label"] == wholeRuns["cases"][i]["label"]);
-    CHECK(mergedRuns["cases"][i]["node"] == wholeRuns["cases"][i]["node"]);  // one machine here
+    CHECK(mergedRuns["cases"][i]["repeats"] == wholeRuns["cases"][i]["repeats"]);
   }
+}
+
+}  // namespace
+
+TEST_CASE("merged shards of a comparison are the unsharded run: images bit for bit, errors to the digit",
+          "[compare][shard][cli]") {
+  TempDir dir("compare_shard");
+  runWholeAndShards(dir.path, kSuite, "", 3);
+  checkMergedIsWhole(dir.path, {shardPath(dir.path, 2), shardPath(dir.path, 0), shardPath(dir.path, 1)});
 
   // Refusals: nothing written, every file as it was.
   fs::create_directories(dir.path / "other");
-  runShards(dir.path / "other", "--seed 7", 3, {2});  // another run
+  runShards(dir.path / "other", kSuite, "--seed 7", 3, {2});  // another run
   fs::create_directories(dir.path / "four");
-  runShards(dir.path / "four", "", 4, {2});  // another split
+  runShards(dir.path / "four", kSuite, "", 4, {2});  // another split
   const std::string merge = fmt::format("merge --out-dir {} ", (dir.path / "m").string());
   const std::string s0 = shardPath(dir.path, 0), s1 = shardPath(dir.path, 1), s2 = shardPath(dir.path, 2);
   checkRefusals(dir.path,
@@ -99,6 +118,37 @@ TEST_CASE("merged shards of a comparison are the unsharded run: images bit for b
                  {merge + s0 + " " + s1 + " " + shardPath(dir.path / "four", 2), "into 3 and 4 shards"},
                  {merge + s0 + " " + s1 + " " + (dir.path / "whole").string(), "not a shard of a comparison"},
                  {merge + s0 + " " + s1 + " " + s2 + " --out x.exr", "--out FILE.exr"},
-                 {compareArgs(dir.path, "--shard 7/8 --out-dir " + (dir.path / "m").string()), "fewer than the 8"}},
+                 {compareArgs(dir.path, kSuite, "--shard 7/8 --out-dir " + (dir.path / "m").string()),
+                  "fewer than the 8"}},
+                dir.path / "m");
+}
+
+TEST_CASE("merged shards of a comparison by scene and repeat are the unsharded run, bit for bit",
+          "[compare][shard][cli]") {
+  // Three units, (sun, repeat 0..2), on two shards: the scene's runs come from both.
+  TempDir dir("compare_shard_repeat");
+  runWholeAndShards(dir.path, kRepeats, "--shard-unit repeat", 2);
+  const std::string s0 = shardPath(dir.path, 0), s1 = shardPath(dir.path, 1);
+  checkMergedIsWhole(dir.path, {s1, s0});
+
+  // Refusals: nothing written, every file as it was.
+  fs::create_directories(dir.path / "scene");
+  runShards(dir.path / "scene", kRepeats, "", 2, {0});  // the same run by scene
+  // Shard 0's folder relabelled as shard 1: both hold repeats 0 and 2.
+  const fs::path relabelled = dir.path / "relabelled";
+  fs::copy(s0, relabelled, fs::copy_options::recursive);
+  auto record = nlohmann::json::parse(readText(relabelled / "shard.json"));
+  record["shard"][0] = 1;
+  writeText(relabelled / "shard.json", record.dump());
+  const std::string merge = fmt::format("merge --out-dir {} ", (dir.path / "m").string());
+  const std::string out = " --out-dir " + (dir.path / "m").string();
+  checkRefusals(dir.path,
+                {{merge + s1 + " " + shardPath(dir.path / "scene", 0), "split the run by repeat and by scene"},
+                 {merge + s1, "shard 0/2 is missing"},
+                 {merge + s0 + " " + s0 + " " + s1, "are the same shard"},
+                 {merge + s0 + " " + relabelled.string(), "both hold repeat 0 of sun"},
+                 {compareArgs(dir.path, kRepeats, "--shard-unit repeat --shard 3/4" + out), "fewer than the 4"},
+                 {compareArgs(dir.path, kRepeats, "--shard-unit cube --shard 0/2" + out), "expected scene or repeat"},
+                 {compareArgs(dir.path, kRepeats, "--shard-unit repeat" + out), "--shard-unit requires --shard"}},
                 dir.path / "m");
 }

@@ -26,6 +26,7 @@
 #include "compare/Comparison.h"
 #include "compare/EnvmapPdfComparison.h"
 #include "compare/ShardRecord.h"
+#include "compare/ShardUnit.h"
 #include "compare/Suite.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
@@ -41,6 +42,7 @@ struct CompareArgs {
   DeviceArgs devices;
   CompareOptions compare;
   std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal", shard;
+  std::string shardUnit = "scene";
   bool suite = false;
 };
 
@@ -84,20 +86,23 @@ int runCompare(CompareArgs& args) {
     }
   } else {
     Scene probe = args.scene.make();  // reads the envmap once, so bad input fails before any work
-    compare.cases.push_back({caseLabel(probe.options), probe.options, {}});
+    compare.cases.push_back({caseLabel(probe.options), probe.options, {}, {}});
     // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
+  const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
   std::optional<ShardRecord> shard;
   if (!args.shard.empty()) {
-    // Every shard knows the whole run's cases, in order, for the merge.
+    // Every shard knows the whole run's cases, in order, for the merge; the merge
+    // checks the unit itself, to name it when shards of two units meet.
     shard.emplace();
-    shard->run = runIdentity(*args.command, {"--shard", "--out-dir", "--cache-dir", "--help"});
+    shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"});
     shard->shard = parseShard(args.shard, "--shard");
+    shard->unit = unit;
     for (const CompareCase& c : casesPerEnvmapPdf(compare.cases, pdfs)) shard->manifest.push_back(c.label);
-    compare.cases = shardScenes(compare.cases, shard->shard);
   }
+  compare.cases = shardCases(compare.cases, compare.repeats, unit, shard ? shard->shard : Shard{});
   compare.cases = casesPerEnvmapPdf(compare.cases, pdfs);
   for (CompareCase& c : compare.cases) c.scene.bankCacheDir = compare.cacheDir;
   compare.methods = parseMethodList(args.methods);
@@ -183,9 +188,15 @@ Subcommand addCompareCommand(CLI::App& app) {
       ->check(integerIn(1, INT_MAX));
   compare.cacheDir = defaultCacheDir();
   command->add_option("--cache-dir", compare.cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
-  command->add_option("--shard", args->shard,
-                      "K/N: run shard K of N (every N-th scene with all its methods, pdfs, budgets and repeats) "
-                      "into --out-dir, for `misalloc merge --out-dir`");
+  auto* shardOption = command->add_option(
+      "--shard", args->shard,
+      "K/N: run shard K of N (every N-th unit of --shard-unit) into --out-dir, for `misalloc merge --out-dir`");
+  command
+      ->add_option("--shard-unit", args->shardUnit,
+                   "with --shard: scene (a scene's methods, pdfs, budgets and repeats in one shard) or repeat (a "
+                   "scene's repeat with all its methods, pdfs and budgets)")
+      ->capture_default_str()
+      ->needs(shardOption);
   return {command, [args] { return runCompare(*args); }};
 }
 

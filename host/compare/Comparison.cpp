@@ -37,6 +37,7 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.budget = budget;
   rec.repeat = repeat;
   rec.seed = seed;
+  rec.node = nodeName();
   rec.wallSeconds = r.wallSeconds;
   rec.kernelSeconds = r.kernelSeconds;
   rec.allocationSeconds = r.allocationSeconds;
@@ -61,6 +62,7 @@ nlohmann::json runJson(const RunRecord& r) {
           {"spp", r.budget},
           {"repeat", r.repeat},
           {"seed", r.seed},
+          {"node", r.node},
           {"time_s", timeSplitJson(r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds)},
           {"rmse_x1000", 1000 * std::sqrt(r.rawMse)},
           {"rmse_x1000_corrected", 1000 * std::sqrt(std::max(0.0, r.mse))},
@@ -108,8 +110,8 @@ nlohmann::json caseInfoJson(const CaseInfo& c) {
           {"reference", c.referenceSource},
           {"reference_variance", c.referenceVariance},
           {"device", c.device},
-          {"node", c.node},
-          {"left_out", leftOutJson(c.leftOut)}};
+          {"left_out", leftOutJson(c.leftOut)},
+          {"repeats", c.repeats}};
 }
 
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
@@ -158,7 +160,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
   fs::create_directories(options.outDir);
   int runs = 0;
   for (const CompareCase& c : options.cases)
-    runs += int(caseMethods(c, options.methods).size() * options.budgets.size()) * options.repeats;
+    runs += int(caseMethods(c, options.methods).size() * options.budgets.size() * c.repeats.size());
   ProgressMeter meter(runs);
   SamplerDevices devices(options.device);
   Comparison out;
@@ -179,7 +181,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     double referenceVariance = 0;
     for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name(), nodeName(), c.leftOut});
+                         reference->source, referenceVariance, devices.name(), c.leftOut, c.repeats});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
@@ -192,7 +194,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
       for (Method method : methods)
         samplers.push_back(devices.makeSampler(
             scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize));
-      for (int r = 0; r < options.repeats; ++r)
+      for (int r : c.repeats)
         for (size_t m = 0; m < methods.size(); ++m) {
           const Method method = methods[m];
           if (guard.requested()) {

@@ -22,6 +22,7 @@ struct CompareCase {
   std::string label;
   SceneOptions scene;
   std::vector<LeftOutMethod> leftOut;  // the default pdfs: methods biased with this case's pdf
+  std::vector<int> repeats;            // the repeats this process runs, ascending (compare/ShardUnit.h)
 };
 
 // The methods of `methods` that `c` runs, in that order.
@@ -49,6 +50,7 @@ struct RunRecord {
   int budget = 0;
   int repeat = 0;
   uint64_t seed = 0;
+  std::string node;  // the host it ran on: timings compare only within one node
   double wallSeconds = 0, kernelSeconds = 0, allocationSeconds = 0, hostSeconds = 0;
   // Against the reference: `mse` corrected for the reference's own variance (what every
   // table, curve and speed-up uses; one repeat's may be below 0), with its standard
@@ -75,8 +77,8 @@ struct CaseInfo {
   std::string referenceSource;
   double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;
-  std::string node;  // the host its runs ran on: timings compare only within one node
   std::vector<LeftOutMethod> leftOut;
+  std::vector<int> repeats;  // those its runs are of: a shard's, or all
 };
 
 struct Comparison {
@@ -85,7 +87,7 @@ struct Comparison {
   bool interrupted = false;  // runs holds only what finished
 };
 
-// Every case × method × budget × repeat, in that order. Writes each repeat-0 render's
+// Every case × budget × repeat (the case's own) × method, in that order. Writes each repeat-0 render's
 // image and α map (EXR + PNG) under outDir/<case>/ as it goes, and the runs so far to
 // outDir/runs.{json,csv} after each one, all atomically. Stops after the render in
 // flight when `guard` reports SIGINT or SIGTERM (Comparison::interrupted).

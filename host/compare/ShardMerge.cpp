@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <numeric>
+#include <tuple>
 
 #include "Error.h"
 #include "compare/ShardRecord.h"
@@ -12,7 +14,7 @@ namespace misalloc {
 namespace fs = std::filesystem;
 namespace {
 
-// Refuses records that are not exactly one run's N complete shards, each once.
+// Refuses records that are not exactly one run's N complete shards of one unit, each once.
 void requireOneRun(const std::vector<std::string>& folders, const std::vector<ShardRecord>& records) {
   const ShardRecord& first = records.front();
   std::vector<int> seen(size_t(first.shard.count), -1);
@@ -24,6 +26,9 @@ void requireOneRun(const std::vector<std::string>& folders, const std::vector<Sh
     if (r.shard.count != first.shard.count)
       throw InputError(fmt::format("{} and {} split the run into {} and {} shards", folders.front(), folders[i],
                                    first.shard.count, r.shard.count));
+    if (r.unit != first.unit)
+      throw InputError(fmt::format("{} and {} split the run by {} and by {}: merge the shards of one --shard-unit",
+                                   folders.front(), folders[i], shardUnitName(first.unit), shardUnitName(r.unit)));
     if (r.comparison.interrupted)
       throw InputError(
           fmt::format("{}: shard {}/{} was interrupted; run it again", folders[i], r.shard.index, r.shard.count));
@@ -35,6 +40,47 @@ void requireOneRun(const std::vector<std::string>& folders, const std::vector<Sh
   }
   for (size_t k = 0; k < seen.size(); ++k)
     if (seen[k] < 0) throw InputError(fmt::format("shard {}/{} is missing", k, first.shard.count));
+}
+
+const CaseInfo* findCase(const ShardRecord& record, const std::string& label) {
+  const auto& cases = record.comparison.cases;
+  auto c = std::find_if(cases.begin(), cases.end(), [&](const CaseInfo& i) { return i.label == label; });
+  return c == cases.end() ? nullptr : &*c;
+}
+
+// Appends the case `label` joined from the shards that ran its repeats, each repeat by
+// exactly one, and its runs in the unsharded order. Its record is that of the shard
+// that ran repeat 0, whose images the folder holds.
+void mergeCase(const std::string& label, int repeats, const std::vector<std::string>& folders,
+               const std::vector<ShardRecord>& records, Comparison& merged) {
+  std::vector<int> holder(size_t(repeats), -1);  // the record that ran each repeat
+  const size_t firstRun = merged.runs.size();
+  for (size_t i = 0; i < records.size(); ++i) {
+    const CaseInfo* c = findCase(records[i], label);
+    if (!c) continue;
+    for (int r : c->repeats) {
+      if (r < 0 || r >= repeats)
+        throw InputError(fmt::format("{}: repeat {} of {} is not one of the run's {}", folders[i], r, label, repeats));
+      int& other = holder[size_t(r)];
+      if (other >= 0)
+        throw InputError(
+            fmt::format("{} and {} both hold repeat {} of {}", folders[size_t(other)], folders[i], r, label));
+      other = int(i);
+    }
+    for (const RunRecord& run : records[i].comparison.runs)
+      if (run.caseLabel == label) merged.runs.push_back(run);
+  }
+  for (size_t r = 0; r < holder.size(); ++r)
+    if (holder[r] < 0) throw InputError(fmt::format("no shard holds repeat {} of {}", r, label));
+  CaseInfo info = *findCase(records[size_t(holder.front())], label);
+  info.repeats.resize(size_t(repeats));
+  std::iota(info.repeats.begin(), info.repeats.end(), 0);
+  merged.cases.push_back(std::move(info));
+  // Budget, then repeat, then method: within a repeat, its shard's order.
+  std::stable_sort(merged.runs.begin() + std::ptrdiff_t(firstRun), merged.runs.end(),
+                   [](const RunRecord& a, const RunRecord& b) {
+                     return std::tie(a.budget, a.repeat) < std::tie(b.budget, b.repeat);
+                   });
 }
 
 }  // namespace
@@ -49,20 +95,7 @@ MergedComparison mergeShards(const std::vector<std::string>& folders) {
   merged.options.budgets = first.budgets;
   merged.options.repeats = first.repeats;
   merged.options.tableBudget = first.tableBudget;
-  // The cases in the manifest's order, each with its runs in the order its shard ran them.
-  for (const std::string& label : first.manifest) {
-    for (const ShardRecord& r : records) {
-      const auto& cases = r.comparison.cases;
-      auto c = std::find_if(cases.begin(), cases.end(), [&](const CaseInfo& i) { return i.label == label; });
-      if (c == cases.end()) continue;
-      merged.comparison.cases.push_back(*c);
-      for (const RunRecord& run : r.comparison.runs)
-        if (run.caseLabel == label) merged.comparison.runs.push_back(run);
-    }
-  }
-  if (merged.comparison.cases.size() != first.manifest.size())
-    throw InputError(
-        fmt::format("the shards hold {} of the run's {} cases", merged.comparison.cases.size(), first.manifest.size()));
+  for (const std::string& label : first.manifest) mergeCase(label, first.repeats, folders, records, merged.comparison);
   return merged;
 }
 

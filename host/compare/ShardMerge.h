@@ -15,8 +15,8 @@ struct MergedComparison {
 };
 
 // Throws InputError, naming the folder, for a folder that is not a shard, shards of
-// different runs (options or versions), a shard given twice or missing, and an
-// interrupted shard.
+// different runs (options or versions) or units, a shard given twice or missing, a
+// repeat of a case that no shard or two shards hold, and an interrupted shard.
 MergedComparison mergeShards(const std::vector<std::string>& folders);
 
 // Copies what the shard in `folder` wrote of its cases (images, α maps, previews) into

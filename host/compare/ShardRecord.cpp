@@ -20,6 +20,7 @@ nlohmann::json runRecordJson(const RunRecord& r) {
           {"budget", r.budget},
           {"repeat", r.repeat},
           {"seed", r.seed},
+          {"node", r.node},
           {"seconds", {r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds}},
           {"mse", {r.mse, r.mseStandardError, r.rawMse, r.relativeMse}},
           {"mean_alpha", r.meanAlpha},
@@ -35,6 +36,7 @@ RunRecord runRecordOf(const nlohmann::json& j) {
   r.budget = j.at("budget");
   r.repeat = j.at("repeat");
   r.seed = j.at("seed");
+  r.node = j.at("node");
   const auto& s = j.at("seconds");
   r.wallSeconds = s.at(0), r.kernelSeconds = s.at(1), r.allocationSeconds = s.at(2), r.hostSeconds = s.at(3);
   const auto& e = j.at("mse");
@@ -65,22 +67,11 @@ CaseInfo caseInfoOf(const nlohmann::json& j) {
           j.at("reference"),
           j.at("reference_variance"),
           j.at("device"),
-          j.at("node"),
-          leftOut};
+          leftOut,
+          j.at("repeats").get<std::vector<int>>()};
 }
 
 }  // namespace
-
-std::vector<CompareCase> shardScenes(const std::vector<CompareCase>& scenes, Shard shard) {
-  std::vector<CompareCase> out;
-  for (size_t i = size_t(shard.index); i < scenes.size(); i += size_t(shard.count)) out.push_back(scenes[i]);
-  if (out.empty())
-    throw InputError(
-        fmt::format("--shard {}/{}: the comparison has {} scene(s), fewer than the {} shards (a scene's "
-                    "runs stay in one shard)",
-                    shard.index, shard.count, scenes.size(), shard.count));
-  return out;
-}
 
 std::string shardRecordJson(const ShardRecord& record) {
   nlohmann::json methods = nlohmann::json::array(), cases = nlohmann::json::array(), runs = nlohmann::json::array();
@@ -89,6 +80,7 @@ std::string shardRecordJson(const ShardRecord& record) {
   for (const RunRecord& r : record.comparison.runs) runs.push_back(runRecordJson(r));
   return jsonText({{"run", record.run},
                    {"shard", {record.shard.index, record.shard.count}},
+                   {"unit", shardUnitName(record.unit)},
                    {"manifest", record.manifest},
                    {"methods", methods},
                    {"budgets", record.budgets},
@@ -113,10 +105,13 @@ ShardRecord readShardRecord(const std::string& folder) {
     if (r.shard.index < 0 || r.shard.index >= r.shard.count)
       throw InputError(
           fmt::format("{}: its {} names shard {}/{}", folder, kShardRecordFile, r.shard.index, r.shard.count));
+    r.unit = parseShardUnit(j.at("unit"), fmt::format("{}: its {}'s unit", folder, kShardRecordFile));
     r.manifest = j.at("manifest").get<std::vector<std::string>>();
     for (const auto& m : j.at("methods")) r.methods.push_back(parseMethod(m));
     r.budgets = j.at("budgets").get<std::vector<int>>();
     r.repeats = j.at("repeats");
+    if (r.repeats < 1)
+      throw InputError(fmt::format("{}: its {} names {} repeats", folder, kShardRecordFile, r.repeats));
     r.tableBudget = j.at("table_spp");
     r.comparison.interrupted = j.at("interrupted");
     for (const auto& c : j.at("cases")) r.comparison.cases.push_back(caseInfoOf(c));

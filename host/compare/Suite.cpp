@@ -26,11 +26,11 @@ std::vector<CompareCase> suiteCases(int width, int height) {
   for (const std::string& map : shippedEnvmapNames()) {
     SceneOptions o = base;
     o.envmap = map;
-    cases.push_back({caseLabel(o), o, {}});
+    cases.push_back({caseLabel(o), o, {}, {}});
   }
   SceneOptions cdf = base;
   cdf.sampler = EnvmapSampler::Cdf;
-  cases.push_back({caseLabel(cdf), cdf, {}});
+  cases.push_back({caseLabel(cdf), cdf, {}, {}});
   return cases;
 }
 

@@ -3,9 +3,10 @@
 # at once (%K), and the merge, which waits for every shard to succeed.
 #   submit.sh compare|render N K OUT [--wait] -- OPTIONS...
 # OPTIONS are those of `misalloc compare` or `misalloc render`, without --shard,
-# --out-dir, --out and --report. MISALLOC names the binary (default: misalloc on PATH);
-# OUT must be on a file system every node sees, and so should --cache-dir. --wait
-# returns when the merge has finished, with its exit status.
+# --out-dir, --out and --report; compare's --shard-unit repeat reaches every shard, and
+# N may then reach the scenes times --repeats. MISALLOC names the binary (default:
+# misalloc on PATH); OUT must be on a file system every node sees, and so should
+# --cache-dir. --wait returns when the merge has finished, with its exit status.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 kind=$1 n=$2 k=$3 out=$(realpath -m "$4")
