@@ -11,6 +11,7 @@ enum class Estimator {
   MultiSample,       // balance heuristic with deterministic counts ([HS14] eq. 4.1)
   OneSample,         // balance heuristic, technique drawn with probabilities α
   CountIndependent,  // weights p_k/Σ_l p_l whatever the counts ([SHS16] eq. 26)
+  Resampled,         // technique 0 alone, each sample resampled from envmap candidates ([TCE05], kernels/ris.h)
 };
 
 // What one sampling stage takes per pixel: counts n_k (multi-sample; for the
@@ -61,6 +62,7 @@ struct SamplerConfig {
   int gridSize = 0;  // > 0: grid searches ([HS14] Algorithm 1) over about this many combinations
   // The grid searches keep running sums, for renders that search more than once.
   bool runningSums = true;
+  int risCandidates = 0;  // the resampled estimator's candidates per sample; 0 for the others
 };
 
 // Where the stored samples are: the blocked float layout of kernels/stats.h
