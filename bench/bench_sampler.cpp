@@ -19,6 +19,7 @@
 #include "PeerComparison.h"
 #include "cl/Device.h"
 #include "render/Method.h"
+#include "render/Render.h"
 #include "sampling/HostSampler.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
@@ -44,6 +45,7 @@ const Variant kVariants[] = {
     {"brdf", Method::Brdf, EnvmapSampler::Alias},
     {"MIS equal (alias)", Method::Equal, EnvmapSampler::Alias},
     {"MIS equal (cdf)", Method::Equal, EnvmapSampler::Cdf},
+    {fmt::format("ris, {} candidates (alias)", kDefaultRisCandidates), Method::Ris, EnvmapSampler::Alias},
 };
 
 Scene benchScene(EnvmapSampler sampler) {
@@ -53,6 +55,11 @@ Scene benchScene(EnvmapSampler sampler) {
   o.envmap = config.envmap;
   o.proceduralWidth = config.proceduralWidth;
   return makeScene(o);
+}
+
+// What a render of the variant's method builds: ris its own estimator.
+SamplerConfig configOf(const Variant& v) {
+  return samplerConfigFor(v.method, Estimator::MultiSample, config.spp, AdaptiveOptions{});
 }
 
 const Device& device() {
@@ -70,13 +77,13 @@ void runStages(benchmark::State& state, StageSampler& sampler, const StagePlan& 
 
 void benchOpenCl(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  Sampler sampler(device(), scene);
+  Sampler sampler(device(), scene, configOf(v));
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 
 void benchOpenMp(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  HostSampler sampler(scene);
+  HostSampler sampler(scene, configOf(v));
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 

@@ -7,10 +7,12 @@
 #ifndef MA_PIXEL_H
 #define MA_PIXEL_H
 #include "estimator.h"
+#include "ris.h"
 
 typedef struct {
   int techniqueCount, stageSamples, oneSample;
   int countIndependent;            // [SHS16] eq. 26 instead of the balance heuristic
+  int risCandidates;               // > 0: technique 0 resamples this many envmap candidates ([TCE05])
   int n0, n1, n2;                  // this stage's counts (one-sample: expected counts)
   ma_uint first0, first1, first2;  // index of each technique's first sample this stage
 } StageCounts;
@@ -18,7 +20,8 @@ typedef struct {
 // A pixel's StageCounts from the stage's per-pixel arrays ([pixel·M + k]), as the
 // kernel and its C++ reference both read them.
 MA_FN StageCounts loadStageCounts(MA_GLOBAL const int* counts, MA_GLOBAL const ma_uint* firstIndex, int pixel,
-                                  int techniqueCount, int stageSamples, int oneSample, int countIndependent) {
+                                  int techniqueCount, int stageSamples, int oneSample, int countIndependent,
+                                  int risCandidates) {
   MA_GLOBAL const int* n = counts + pixel * techniqueCount;
   MA_GLOBAL const ma_uint* first = firstIndex + pixel * techniqueCount;
   StageCounts c;
@@ -26,6 +29,7 @@ MA_FN StageCounts loadStageCounts(MA_GLOBAL const int* counts, MA_GLOBAL const m
   c.stageSamples = stageSamples;
   c.oneSample = oneSample;
   c.countIndependent = countIndependent;
+  c.risCandidates = risCandidates;
   c.n0 = n[0];
   c.n1 = n[1];
   c.n2 = techniqueCount > 2 ? n[techniqueCount - 1] : 0;
@@ -44,7 +48,8 @@ typedef struct {
   int technique;
   int share;      // the bank's share the stage's envmap samples draw with (bankShareOf); 0 without a bank
   float r, g, b;  // the sample's term of the stage estimate
-  float w;        // its luminance value: Y(f)/p_α (balance), Y(f)/Σ_k p_k (count-independent)
+  float w;        // its luminance value: Y(f)/p_α (balance), Y(f)/Σ_k p_k (count-independent),
+                  // (1/M) Σ_i w_i (resampled)
   float y;        // Y(f)
   float pdfs[MA_MAX_TECHNIQUES];
   float sharePdfs[MA_MAX_BANK_SHARES];  // SampleValue::sharePdfs
@@ -72,18 +77,28 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float alpha[MA_MAX_TECHNIQUES];
   stageFractions(c, alpha);
   if (env.bankShares > 0) env.bankEntry = bankEntryOf(env, alpha[0]);
-  MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
-  SampleValue s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
-  // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent
-  // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) ([SHS16] eq. 26).
-  float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
-  float mix[MA_MAX_TECHNIQUES];
-  MA_UNROLL
-  for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) mix[k] = c.countIndependent ? 1.0f : alpha[k];
-  float p = mixturePdf(c.techniqueCount, mix, s.pdfs);
-  float scale = c.countIndependent ? nt : N;
-  // p = 0 only where no technique can sample, so f = 0 there too.
-  float invP = p > 0.0f ? 1.0f / p : 0.0f;
+  SampleValue s;
+  float invP, scale;
+  if (technique == MA_TECHNIQUE_ENVMAP && c.risCandidates > 0) {
+    // [TCE05]: f(y) times the resampled sample's weight, over N.
+    ResampledSample y = resampleEnvmap(ts, env, b, c.risCandidates, seedLo, seedHi, pixel, index);
+    s = y.value;
+    invP = y.contributionWeight;
+    scale = N;
+  } else {
+    MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
+    s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
+    // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent
+    // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) ([SHS16] eq. 26).
+    float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
+    float mix[MA_MAX_TECHNIQUES];
+    MA_UNROLL
+    for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) mix[k] = c.countIndependent ? 1.0f : alpha[k];
+    float p = mixturePdf(c.techniqueCount, mix, s.pdfs);
+    scale = c.countIndependent ? nt : N;
+    // p = 0 only where no technique can sample, so f = 0 there too.
+    invP = p > 0.0f ? 1.0f / p : 0.0f;
+  }
   SampleContribution out;
   out.technique = technique;
   out.share = env.bankShares > 0 ? bankShareOf(env.bankShares, alpha[0]) : 0;

@@ -5,7 +5,8 @@
 // Compile-time options (sampleKernelOptions in host/sampling/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
 // MA_COSK (< 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
-// bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_STATS (the
+// bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
+// (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_LOCAL_SIZE. Constants fold the
 // unused techniques, sampler, estimator and statistics away.
@@ -87,6 +88,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   c.stageSamples = stageSamples;
   c.oneSample = MA_ONE_SAMPLE;
   c.countIndependent = MA_COUNT_INDEPENDENT;
+  c.risCandidates = MA_RIS_CANDIDATES;
   c.n0 = PIXEL_ROW(ROW_N0);
   c.n1 = PIXEL_ROW(ROW_N1);
   c.n2 = PIXEL_ROW(ROW_N2);
@@ -118,8 +120,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
-  StageCounts pixelCounts =
-      loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT);
+  StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                            MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
   int rowValues[ROW_COUNT] = {as_int(brdfParams[4 * pixel + 0]),
                               as_int(brdfParams[4 * pixel + 1]),
                               as_int(brdfParams[4 * pixel + 2]),

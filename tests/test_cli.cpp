@@ -65,6 +65,8 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--method heuristic --spp 40 --cost 1", "expected 2 numbers"},
       {"--method heuristic --pilot 1.5", "--pilot: '1.5'"},
       {"--method heuristic --estimator one", "multi-sample stages"},
+      {"--method ris --estimator one", "an estimator of its own"},
+      {"--method ris --envmap-pdf optimal", "--method ris with --envmap-pdf optimal"},
       {"--grid marble", "unknown --grid 'marble'"},
       {"--grid uniform:0.8,0.8,10", "ρd + ρs ≤ 1"},
       {"--device 99", "--device '99'"},

@@ -87,7 +87,7 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
     for (const Scene* scene : {&two, &three}) {
       for (Method method : allMethods()) {
         std::vector<Estimator> estimators{Estimator::MultiSample};
-        if (!isAdaptive(method)) estimators.push_back(Estimator::OneSample);
+        if (!methodTraits(method).fixesEstimator()) estimators.push_back(Estimator::OneSample);
         // The count-independent weights need every technique sampled (render/RunChecks.h).
         if (method == Method::Equal) estimators.push_back(Estimator::CountIndependent);
         for (Estimator estimator : estimators) {

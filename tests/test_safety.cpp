@@ -281,6 +281,7 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
       count("--stages", 1),
       count("--grid-u", 2, "16777217"),
       count("--oracle-spp", 2),
+      count("--ris-candidates", 1, "17"),
       {"--cost", {"1,nan", "1,inf", "1,0", "1,-1", "1", "1,2,3", "1,,2", "''", "junk,1", "1e309,1"}},
   };
   std::vector<std::pair<std::string, NumericOption>> table;

@@ -10,6 +10,7 @@
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 #include "alloc/GridSearch.h"
+#include "render/Render.h"
 #include "sampling/HostSampler.h"
 
 using namespace misalloc;
@@ -127,6 +128,41 @@ TEST_CASE("a stored sample's share columns hold the pdf of each share, its own s
     CHECK(sharesSeen == std::vector<int>(shares, 1));
     CHECK(otherShareDiffers > 0);  // the shares' tables differ: the columns are not copies
   }
+}
+
+// ris's candidate loop, unrolled in the kernel and a loop in the reference. The default
+// candidates on a map whose kernel tests/test_devices.cpp builds too: PoCL compiles an
+// unrolled loop for seconds per candidate count (docs/pocl.md).
+TEST_CASE("resampled sampling on PoCL matches its C++ reference bit for bit", "[sampler][ris]") {
+  for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+    const Scene scene = smallScene("rooitou_park", "seed000", 24, 16, false, s);
+    const SamplerConfig config = samplerConfigFor(Method::Ris, Estimator::MultiSample, 50, AdaptiveOptions{});
+    Sampler device(testDevice(), scene, config);
+    HostSampler host(scene, config);
+    const StagePlan plan = singleStagePlan(scene, Method::Ris, 50);
+    StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+    size_t mismatches = 0;
+    for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+    for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+    INFO(fmt::format("cdf {}", s == EnvmapSampler::Cdf));
+    CHECK(mismatches == 0);
+  }
+}
+
+// With one candidate, resampling keeps the envmap technique's own sample: the same
+// random numbers and the same value, f(y) (p̂/p)/p̂ for f/p: two more roundings.
+TEST_CASE("one candidate resampled is envmap sampling", "[sampler][ris]") {
+  const Scene scene = smallScene("rooitou_park", "seed000", 24, 16);
+  AdaptiveOptions options;
+  options.risCandidates = 1;
+  HostSampler resampled(scene, samplerConfigFor(Method::Ris, Estimator::MultiSample, 32, options));
+  HostSampler envmap(scene, samplerConfigFor(Method::Envmap, Estimator::MultiSample, 32, options));
+  StageResult a = resampled.run(singleStagePlan(scene, Method::Ris, 32), 3);
+  StageResult b = envmap.run(singleStagePlan(scene, Method::Envmap, 32), 3);
+  size_t apart = 0;
+  // Sums of positive terms, each within three float roundings of the other's.
+  for (size_t i = 0; i < a.rgb.size(); ++i) apart += std::abs(a.rgb[i] - b.rgb[i]) > 4 * 0x1p-24 * b.rgb[i];
+  CHECK(apart == 0);
 }
 
 TEST_CASE("same seed, device and options give bit-identical results", "[sampler][determinism]") {

@@ -58,6 +58,10 @@ void AdaptiveArgs::add(CLI::App& command) {
   command.add_option("--oracle-spp", options.oracleSamples, "oracle: probe samples per pixel")
       ->capture_default_str()
       ->check(integerIn(2, INT_MAX));
+  // The kernel unrolls the candidate loop: M is compiled in.
+  command.add_option("--ris-candidates", options.risCandidates, "ris: envmap candidates resampled per sample")
+      ->capture_default_str()
+      ->check(integerIn(1, kMaxRisCandidates));
 }
 
 AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {

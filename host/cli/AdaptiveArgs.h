@@ -6,7 +6,7 @@
 
 namespace misalloc {
 
-// The options of the adaptive methods, shared by render and compare.
+// The options of the adaptive methods (and of oracle and ris), shared by render and compare.
 struct AdaptiveArgs {
   AdaptiveOptions options;
   std::string costList, linearRule = "variance", gridRule = "variance";

@@ -79,7 +79,7 @@ int runRender(RenderArgs& args) {
   const Method m = parseMethod(args.method);
   const MethodTraits& traits = methodTraits(m);
   const Estimator estimator = parseEstimator(args.estimator);
-  if (m == Method::Envmap) args.scene.usePlainPdfByDefault();  // the optimal pdf does not cover f alone
+  if (traits.envmapOnly) args.scene.usePlainPdfByDefault();  // the optimal pdf does not cover f alone
   std::vector<NamedFile> inputs = envmapInputs({args.scene.parsed()});
   if (args.reference != "auto" && args.reference != "none") inputs.push_back({"--reference", args.reference});
   OutputSet outputs(inputs);
@@ -171,7 +171,9 @@ Subcommand addRenderCommand(CLI::App& app) {
   args->scene.add(*command);
   args->scene.addEnvmapPdf(*command);
   command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
-  command->add_option("--method", args->method, "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear, exact or oracle")
+  command
+      ->add_option("--method", args->method,
+                   "envmap, brdf, equal, heuristic, sigma-sqrt-c, linear, exact, oracle or ris")
       ->capture_default_str();
   args->adaptive.add(*command);
   command->add_option("--alpha-map", args->alphaMap,

@@ -32,6 +32,8 @@ const char* methodColour(Method m) {
       return "#ff7f0e";
     case Method::Oracle:
       return "#7f7f7f";
+    case Method::Ris:
+      return "#17becf";
   }
   return "#000000";
 }

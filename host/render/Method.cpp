@@ -16,20 +16,23 @@ constexpr Estimator kBalance = Estimator::MultiSample;
 
 // One row per method, in the enum's order, which is the order of the tables.
 constexpr MethodTraits kMethods[] = {
-    // method, name, split, searches weights, estimator, statistics, stores samples
-    {Method::Envmap, "envmap", Split::Fixed, false, kBalance, 0, false},
-    {Method::Brdf, "brdf", Split::Fixed, false, kBalance, 0, false},
-    {Method::Equal, "equal", Split::Fixed, false, kBalance, 0, false},
+    // method, name, split, searches weights, estimator, statistics, stores samples, envmap only
+    {Method::Envmap, "envmap", Split::Fixed, false, kBalance, 0, false, true},
+    {Method::Brdf, "brdf", Split::Fixed, false, kBalance, 0, false, false},
+    {Method::Equal, "equal", Split::Fixed, false, kBalance, 0, false, false},
     // [HS14] eq. 4.20 from V_k, eq. 4.18
-    {Method::Heuristic, "heuristic", Split::Staged, false, kBalance, MA_STATS_TECHNIQUE, false},
+    {Method::Heuristic, "heuristic", Split::Staged, false, kBalance, MA_STATS_TECHNIQUE, false, false},
     // [SHS16] eq. 31 from σ_k, eq. 28
-    {Method::SigmaSqrtC, "sigma-sqrt-c", Split::Staged, false, Estimator::CountIndependent, MA_STATS_BALANCE, false},
+    {Method::SigmaSqrtC, "sigma-sqrt-c", Split::Staged, false, Estimator::CountIndependent, MA_STATS_BALANCE, false,
+     false},
     // [SS23] eq. 14; its negative weights by eq. 19 need the samples
-    {Method::Linear, "linear", Split::Staged, false, kBalance, MA_STATS_LINEAR, true},
+    {Method::Linear, "linear", Split::Staged, false, kBalance, MA_STATS_LINEAR, true, false},
     // The grid search reads each stage's samples into sums of its own, per combination.
-    {Method::Exact, "exact", Split::Staged, true, kBalance, 0, true},
+    {Method::Exact, "exact", Split::Staged, true, kBalance, 0, true, false},
     // The grid search reads the probe's samples.
-    {Method::Oracle, "oracle", Split::Probed, true, kBalance, 0, true},
+    {Method::Oracle, "oracle", Split::Probed, true, kBalance, 0, true, false},
+    // [TCE05]: a baseline outside MIS, what a real-time renderer would pick instead.
+    {Method::Ris, "ris", Split::Fixed, false, Estimator::Resampled, 0, false, true},
 };
 
 constexpr bool inEnumOrder() {
@@ -73,6 +76,7 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
   std::vector<int> counts(M, 0);
   switch (method) {
     case Method::Envmap:
+    case Method::Ris:
       counts[0] = spp;
       break;
     case Method::Brdf:

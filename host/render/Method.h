@@ -10,7 +10,7 @@ namespace misalloc {
 // How a pixel's N samples are split among the techniques. What each method is, which
 // estimator and statistics it needs, and how its α is found, is one row of the table in
 // Method.cpp (methodTraits).
-enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle };
+enum class Method { Envmap, Brdf, Equal, Heuristic, SigmaSqrtC, Linear, Exact, Oracle, Ris };
 
 // Where a method's split comes from.
 enum class Split {
@@ -33,12 +33,18 @@ struct MethodTraits {
   bool searchesWeights;
   // The estimator of an adaptive method's stages: σ/√c allocates for the estimator with
   // count-independent weights ([SHS16] Sec. 4), everything else for the balance
-  // heuristic. A fixed split takes the estimator asked for.
+  // heuristic. `ris` is an estimator of its own ([TCE05]). The other fixed splits take
+  // the estimator asked for.
   Estimator estimator;
   unsigned statistics;  // the running sums each pixel keeps (kernels/stats.h)
   bool storesSamples;   // and the samples themselves
+  // Samples from the envmap pdf alone, which must then cover the integrand: the plain
+  // pdf only (render/RunChecks.h).
+  bool envmapOnly;
 
   constexpr bool adaptive() const { return split != Split::Fixed; }
+  // Whether the method's estimator is its own rather than the one asked for.
+  constexpr bool fixesEstimator() const { return adaptive() || estimator == Estimator::Resampled; }
 };
 
 const MethodTraits& methodTraits(Method method);
@@ -52,8 +58,8 @@ std::string methodName(Method method);
 bool isAdaptive(Method method);
 
 // Counts n_k for one pixel of a fixed split, Σ_k n_k = spp. Single-technique methods
-// give the others 0; with the BRDF split into lobes, `brdf` shares its samples by
-// the lobes' albedos.
+// (`ris` resamples the envmap technique's samples) give the others 0; with the BRDF
+// split into lobes, `brdf` shares its samples by the lobes' albedos.
 std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pixel);
 
 // One stage of `spp` samples per pixel with a fixed split's counts.

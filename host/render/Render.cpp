@@ -152,7 +152,8 @@ int largestStatisticsStage(const AdaptiveOptions& options, int spp) {
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options) {
   const MethodTraits& traits = methodTraits(method);
   SamplerConfig config;
-  config.estimator = traits.adaptive() ? traits.estimator : fixedSplitEstimator;
+  config.estimator = traits.fixesEstimator() ? traits.estimator : fixedSplitEstimator;
+  if (config.estimator == Estimator::Resampled) config.risCandidates = options.risCandidates;
   config.statsMask = traits.statistics;
   config.sampleCapacity = traits.storesSamples ? spp : 0;
   if (traits.searchesWeights) {

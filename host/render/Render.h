@@ -11,7 +11,17 @@
 
 namespace misalloc {
 
-// The batched schedule of the adaptive methods ([HS14] Algorithm 1, Sec. 5.2).
+// The candidates of a `ris` sample unless --ris-candidates says otherwise: of 1, 2, 4, 8
+// and 16, the best at equal time against `equal` on three maps (docs/results.md, "RIS as
+// a baseline"). Each candidate costs a whole evaluation of f, so more buy little.
+inline constexpr int kDefaultRisCandidates = 2;
+// The kernel unrolls its candidate loop, one copy of envmap sampling per candidate
+// (kernels/ris.h). At 32, LLVM 15 leaves it rolled and PoCL's sample loop scalar: 3× the
+// time per candidate of 16 (docs/results.md).
+inline constexpr int kMaxRisCandidates = 16;
+
+// The batched schedule of the adaptive methods ([HS14] Algorithm 1, Sec. 5.2), and the
+// options of the other methods that take any (oracle, ris).
 struct AdaptiveOptions {
   double pilotFraction = 0.05;  // of N, split equally among the techniques
   int stages = 1;               // after the pilot
@@ -22,6 +32,7 @@ struct AdaptiveOptions {
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
   GridRule gridRule = GridRule::MinCostVariance;
   int oracleSamples = 1024;  // oracle: equal-count probe samples per pixel
+  int risCandidates = kDefaultRisCandidates;  // ris: envmap candidates per sample ([TCE05])
 };
 
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError

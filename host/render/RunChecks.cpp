@@ -16,12 +16,13 @@ constexpr unsigned kCoveringBrdfTechnique = 1u << 1;
 
 unsigned allTechniques(int M) { return (1u << M) - 1; }
 
-// The techniques a fixed split samples in every pixel that needs them: `envmap` and
-// `brdf` their own, `equal` the first min(spp, M) (methodCounts hands out the remainder
-// from technique 0 on).
+// The techniques a fixed split samples in every pixel that needs them: `envmap`, `ris`
+// and `brdf` their own, `equal` the first min(spp, M) (methodCounts hands out the
+// remainder from technique 0 on).
 unsigned fixedSplitTechniques(Method method, int M, int spp) {
   switch (method) {
     case Method::Envmap:
+    case Method::Ris:
       return kEnvmapTechnique;
     case Method::Brdf:  // with lobes: the diffuse one wherever its albedo is non-zero (methodCounts)
       return kCoveringBrdfTechnique;
@@ -55,12 +56,13 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
   const int M = scene.techniqueCount();
   const EnvmapPdf& pdf = scene.envmapPdf;
   const MethodTraits& traits = methodTraits(method);
-  if (method == Method::Envmap && !pdf.plain())
+  if (traits.envmapOnly && !pdf.plain())
     throw InputError(fmt::format(
-        "--method envmap with --envmap-pdf {}: the pdf is zero where BRDF sampling alone covers the integrand "
-        "(compensated: where the radiance is at or below 2(1-C) times its mean), so envmap sampling alone would "
-        "be biased; use --envmap-pdf plain, or a method that also samples the BRDF",
-        envmapPdfName(pdf)));
+        "--method {} with --envmap-pdf {}: the pdf is zero where BRDF sampling alone covers the integrand "
+        "(compensated: where the radiance is at or below 2(1-C) times its mean), so {} would be biased; use "
+        "--envmap-pdf plain, or a method that also samples the BRDF",
+        traits.name, envmapPdfName(pdf),
+        traits.estimator == Estimator::Resampled ? "resampling envmap candidates ([TCE05])" : "envmap sampling alone"));
   if (traits.split == Split::Fixed) {
     if (coversIntegrand(fixedSplitTechniques(method, M, spp), M, pdf, estimator)) return;
     throw InputError(fmt::format("--spp {} with --method {}{}: the split leaves a technique without samples, and {}; "
@@ -83,6 +85,7 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
 
 bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator) {
   if (estimator == Estimator::CountIndependent) return sampled == allTechniques(techniqueCount);
+  if (estimator == Estimator::Resampled) return pdf.plain() && (sampled & kEnvmapTechnique);
   if (pdf.plain() && (sampled & kEnvmapTechnique)) return true;
   return (sampled & kCoveringBrdfTechnique) != 0;
 }
@@ -91,8 +94,12 @@ void requireValidRun(const SceneOptions& scene, Method method, Estimator estimat
                      const AdaptiveOptions& options) {
   const MethodTraits& traits = methodTraits(method);
   const int M = scene.techniqueCount();
-  if (traits.adaptive() && estimator != Estimator::MultiSample && estimator != traits.estimator)
-    throw InputError(fmt::format("--estimator: --method {} takes multi-sample stages", traits.name));
+  if (traits.fixesEstimator() && estimator != Estimator::MultiSample && estimator != traits.estimator)
+    throw InputError(fmt::format("--estimator: --method {} {}", traits.name,
+                                 traits.adaptive() ? "takes multi-sample stages"
+                                                   : "is an estimator of its own (resampled importance sampling)"));
+  if (traits.estimator == Estimator::Resampled && options.risCandidates < 1)
+    throw InputError(fmt::format("--ris-candidates {}: a sample needs at least one candidate", options.risCandidates));
   if (traits.adaptive() && !options.costs.empty() && int(options.costs.size()) != M)
     throw InputError(fmt::format("--cost: {} technique(s) need {} costs, not {}", M, M, options.costs.size()));
   if (traits.split == Split::Probed && options.oracleSamples < 2 * M)

@@ -13,7 +13,8 @@ namespace misalloc {
 // one does not ([Kar19] Sec. 4: it is zero where the radiance is low); BRDF sampling
 // covers it, and with the BRDF split into lobes the diffuse lobe does, the specular lobe
 // only its own cone. The count-independent weights ([SHS16] eq. 26) give each technique
-// a term that only its own samples estimate: every technique must be sampled.
+// a term that only its own samples estimate: every technique must be sampled. Resampling
+// ([TCE05]) draws its candidates from the envmap pdf alone, which must then cover it.
 bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator);
 
 // Throws InputError, before any work, for a run of `method` on `scene` with `spp`

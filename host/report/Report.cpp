@@ -15,6 +15,8 @@ std::string estimatorName(Estimator estimator) {
       return "one-sample balance heuristic";
     case Estimator::CountIndependent:
       return "count-independent weights ([SHS16] eq. 26)";
+    case Estimator::Resampled:
+      return "resampled importance sampling of envmap candidates ([TCE05])";
   }
   return "?";
 }
@@ -149,6 +151,7 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"devices", devicesJson(r)},
       {"stages", stagesJson(r.stages)},
   };
+  if (run.estimator == Estimator::Resampled) report["ris_candidates"] = run.adaptive.risCandidates;
   if (r.devices.size() > 1) {
     report["imbalance_s"] = r.imbalanceSeconds;
     report["imbalance_fraction"] = r.imbalanceSeconds / r.wallSeconds;

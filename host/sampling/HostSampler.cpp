@@ -64,9 +64,10 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     b.rhoD = p.rhoD;
     b.rhoS = p.rhoS;
     b.n = p.n;
-    const kern::StageCounts c = kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M,
-                                                      plan.stageSamples, config_.estimator == Estimator::OneSample,
-                                                      config_.estimator == Estimator::CountIndependent);
+    const kern::StageCounts c =
+        kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
+                              config_.estimator == Estimator::OneSample,
+                              config_.estimator == Estimator::CountIndependent, config_.risCandidates);
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {

@@ -40,12 +40,12 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
       "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
-      "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_STATS={} -DMA_STORE_SAMPLES={} -DMA_SHARE_COLUMNS={} "
-      "-DMA_LOCAL_SIZE={}",
+      "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
+      "-DMA_SHARE_COLUMNS={} -DMA_LOCAL_SIZE={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent, t.bankShares, t.blockLog2, config.estimator == Estimator::OneSample ? 1 : 0,
-      config.estimator == Estimator::CountIndependent ? 1 : 0, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
-      sampleColumns(scene, config).shareColumns, localSize);
+      config.estimator == Estimator::CountIndependent ? 1 : 0, config.risCandidates, config.statsMask,
+      config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, localSize);
 }
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {

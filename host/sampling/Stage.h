@@ -12,6 +12,7 @@ enum class Estimator {
   MultiSample,       // balance heuristic with deterministic counts ([HS14] eq. 4.1)
   OneSample,         // balance heuristic, technique drawn with probabilities α
   CountIndependent,  // weights p_k/Σ_l p_l whatever the counts ([SHS16] eq. 26)
+  Resampled,         // technique 0 alone, each sample resampled from envmap candidates ([TCE05], kernels/ris.h)
 };
 
 // What one sampling stage takes per pixel: counts n_k (multi-sample; for the
@@ -65,6 +66,7 @@ struct SamplerConfig {
   // The stored samples carry the envmap's pdf under every share of the optimal pdf's
   // bank, where the scene has one (SampleColumns): for the grid search's rule (b).
   bool shareColumns = false;
+  int risCandidates = 0;  // the resampled estimator's candidates per sample; 0 for the others
 };
 
 // The columns of a stored sample (kernels/stats.h): the pdfs an allocation weighs, one

@@ -9,9 +9,11 @@ namespace misalloc {
 
 StageStatistics::StageStatistics(const Scene& scene, const SamplerConfig& config) : scene_(scene), config_(config) {
   if (config.sampleCapacity < 0) throw std::invalid_argument("negative sample capacity");
-  if (config.estimator == Estimator::OneSample &&
+  if ((config.estimator == Estimator::OneSample || config.estimator == Estimator::Resampled) &&
       (config.statsMask != 0 || config.sampleCapacity > 0 || config.gridSize > 0))
     throw std::invalid_argument("the allocations' statistics are kept for the multi-sample estimators only");
+  if ((config.estimator == Estimator::Resampled) != (config.risCandidates > 0))
+    throw std::invalid_argument("resampling needs candidates, and only resampling takes them");
 }
 
 int StageStatistics::statSlots() const {

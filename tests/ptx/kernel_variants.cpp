@@ -26,9 +26,11 @@
 #include <utility>
 #include <vector>
 
+#include "Error.h"
 #include "alloc/GridSearch.h"
 #include "render/Method.h"
 #include "render/Render.h"
+#include "render/RunChecks.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
 
@@ -61,8 +63,9 @@ Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler, const 
 
 // Every program a Sampler can build: per scene, each method's config (the fixed splits
 // with every estimator) and its plainConfig, at each work-group size, and the grid
-// search where the config asks for one (Sampler's constructor). The optimal pdf's bank
-// (M = 2 only) on one map: the map changes MA_COSK alone.
+// search where the config asks for one (Sampler's constructor); not those of runs that
+// requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank (M = 2
+// only) on one map: the map changes MA_COSK alone.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
   for (const std::string pdf : {"plain", "optimal"})
@@ -73,6 +76,11 @@ std::set<Variant> hostVariants() {
           Scene s = scene(envmap, split, sampler, pdf);
           for (Method method : allMethods())
             for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent}) {
+              try {
+                requireValidRun(s.options, method, estimator, 64, AdaptiveOptions{});
+              } catch (const InputError&) {
+                continue;
+              }
               SamplerConfig config = samplerConfigFor(method, estimator, 64, AdaptiveOptions{});
               for (int localSize : {8, 64, 128, 256}) {
                 variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
