@@ -92,7 +92,11 @@ typedef struct {
 // remainder |r| ≤ π/4 from two short Taylor polynomials (error ~2e-9).
 MA_FN MaSinCos sinCos2Pi(float u) {
   float v = 4.0f * u;
-  float q = ma_floor(v + 0.5f);
+  // ⌊v + ½⌋ by truncation, v ≥ 0. PoCL inlines its floor builtin with branches, and on
+  // its haswell target LLVM's SLP vectoriser then pairs the θ and φ rotations of
+  // latLongDirection into 2-wide vectors, which keep the envmap technique's sample loop
+  // from being vectorised across work-items: 2.8-3.4x slower (docs/pocl.md).
+  float q = (float)(int)(v + 0.5f);
   float r = (v - q) * (0.5f * MA_PI);
   float r2 = r * r;
   float sr =
