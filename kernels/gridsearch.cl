@@ -5,8 +5,10 @@
 // reference: host/alloc/GridSearch.h. What both share: kernels/gridsearch.h.
 //
 // Compile-time options (GridSearch's constructor): MA_TECHNIQUES (M, the stored
-// samples' columns), MA_SHARE_COLUMNS (S, kernels/stats.h) and MA_GRID_VECTORS (B), the
-// float16s of combinations summed in one pass over the samples.
+// samples' columns), MA_SHARE_COLUMNS (S, kernels/stats.h), MA_GRID_VECTORS (B), the
+// float16s of combinations summed in one pass over the samples, and
+// MA_GRID_OPTIMAL_WEIGHTS: rule (b) ranks by the variance with [Kon19]'s optimal weights
+// (optimalVarianceScore), from the sums P over every sample besides S2 and M_j.
 //
 // Shape (docs/pocl.md): explicit float16 arithmetic is what
 // reaches 512-bit code on PoCL. Lanes are combinations, not pixels, so a sample's
@@ -33,11 +35,14 @@
 #include "gridsearch.h"
 
 #define MA_PASS (16 * MA_GRID_VECTORS)  // combinations per pass over the samples
+#define MA_EVERY_SAMPLE MA_GRID_OPTIMAL_WEIGHTS
+#define MA_PAIR_COUNT MA_PAIRS(MA_TECHNIQUES)
 
-// g = f/p_α of the prepared sample x (prepareSample) for the combinations of the pass,
-// alpha[v][k] holding α_k of the 16 combinations of vector v: one division for all
-// (MA_BATCH_QUOTIENTS).
-MA_FN void passQuotients(__global const float* x, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES], float16* g) {
+// numerator/p_α of the prepared sample x (prepareSample) for the combinations of the
+// pass, alpha[v][k] holding α_k of the 16 combinations of vector v: one division for all
+// (MA_BATCH_QUOTIENTS). With numerator f, g = f/p_α.
+MA_FN void passQuotients(__global const float* x, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
+                         float16 numerator, float16* g) {
   float16 p[MA_GRID_VECTORS];
   MA_UNROLL
   for (int v = 0; v < MA_GRID_VECTORS; ++v) {
@@ -45,7 +50,7 @@ MA_FN void passQuotients(__global const float* x, const float16 alpha[MA_GRID_VE
     MA_UNROLL
     for (int k = 1; k < MA_TECHNIQUES; ++k) p[v] = fma(alpha[v][k], (float16)x[1 + k], p[v]);
   }
-  MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, (float16)x[0], p, g);
+  MA_BATCH_QUOTIENTS(float16, MA_GRID_VECTORS, numerator, p, g);
 }
 
 // Adds g and g² of technique j's n prepared samples (prepareSample) to its sums for the
@@ -62,7 +67,7 @@ MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alp
   for (int i = 0; i < n; ++i) {
     __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
     float16 g[MA_GRID_VECTORS];
-    passQuotients(x, alpha, g);
+    passQuotients(x, alpha, (float16)x[0], g);
     MA_UNROLL
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       s[v] += g[v];
@@ -78,15 +83,34 @@ MA_FN void sumTechnique(__global const float* prepared, int n, const float16 alp
 
 // Rule (b)'s sums over the n prepared samples of a batch with technique fractions
 // stageMix (kernels/gridsearch.h, costVarianceScore): M_j += g r_j into sumM[j] and
-// S2 += g w into sumS2, for the combinations l0 … l0 + MA_PASS − 1.
+// S2 += g w into sumS2, for the combinations l0 … l0 + MA_PASS − 1. With optimal weights
+// also P_ik += (p_i/p_α) r_k into sumP (optimalVarianceScore), from 1/p_α, whose batch
+// then gives g = f · (1/p_α) too.
 MA_FN void sumMixture(__global const float* prepared, int n, const float16 alpha[MA_GRID_VECTORS][MA_TECHNIQUES],
-                      const float* stageMix, float16 sumM[MA_TECHNIQUES][MA_GRID_VECTORS], float16* sumS2) {
+                      const float* stageMix, float16 sumM[MA_TECHNIQUES][MA_GRID_VECTORS], float16* sumS2,
+                      float16 sumP[][MA_GRID_VECTORS]) {
   for (int i = 0; i < n; ++i) {
     __global const float* x = prepared + i * (MA_TECHNIQUES + 1);
     float r[MA_TECHNIQUES];
     float w = mixtureWeights(MA_TECHNIQUES, stageMix, x, r);
     float16 g[MA_GRID_VECTORS];
-    passQuotients(x, alpha, g);
+#if MA_GRID_OPTIMAL_WEIGHTS
+    float16 inverse[MA_GRID_VECTORS];
+    passQuotients(x, alpha, (float16)1.0f, inverse);
+    MA_UNROLL
+    for (int v = 0; v < MA_GRID_VECTORS; ++v) {
+      g[v] = inverse[v] * x[0];
+      int pair = 0;
+      MA_UNROLL
+      for (int a = 0; a < MA_TECHNIQUES; ++a) {
+        float16 t = inverse[v] * x[1 + a];
+        MA_UNROLL
+        for (int b = a; b < MA_TECHNIQUES; ++b, ++pair) sumP[pair][v] = fma(t, (float16)r[b], sumP[pair][v]);
+      }
+    }
+#else
+    passQuotients(x, alpha, (float16)x[0], g);
+#endif
     MA_UNROLL
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       sumS2[v] = fma(g[v], (float16)w, sumS2[v]);
@@ -140,8 +164,8 @@ MA_FN float bestScore(LaneBest best) {
 // `sums` = the pixel's first, brought to the current scale (sumsRescale; 0: none yet).
 MA_FN void loadSums(__global const float* sums, int j, int l0, int paddedSize, float rescale, float16* sumG,
                     float16* sumG2) {
-  __global const float* s = sums + runningSumIndex(0, j, 0, l0, MA_TECHNIQUES, paddedSize);
-  __global const float* s2 = sums + runningSumIndex(0, j, 1, l0, MA_TECHNIQUES, paddedSize);
+  __global const float* s = sums + runningSumIndex(j, 0, l0, paddedSize);
+  __global const float* s2 = sums + runningSumIndex(j, 1, l0, paddedSize);
   for (int v = 0; v < MA_GRID_VECTORS; ++v) sumG[v] = sumG2[v] = 0.0f;
   if (rescale == 0.0f) return;
   float rescale2 = rescale * rescale;
@@ -154,9 +178,22 @@ MA_FN void loadSums(__global const float* sums, int j, int l0, int paddedSize, f
 // The sums back where loadSums found them, for the next search.
 MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const float16* sumG, const float16* sumG2) {
   for (int v = 0; v < MA_GRID_VECTORS; ++v) {
-    vstore16(sumG[v], v, sums + runningSumIndex(0, j, 0, l0, MA_TECHNIQUES, paddedSize));
-    vstore16(sumG2[v], v, sums + runningSumIndex(0, j, 1, l0, MA_TECHNIQUES, paddedSize));
+    vstore16(sumG[v], v, sums + runningSumIndex(j, 0, l0, paddedSize));
+    vstore16(sumG2[v], v, sums + runningSumIndex(j, 1, l0, paddedSize));
   }
+}
+
+// P's pair of the combinations l0 … l0 + MA_PASS − 1, as loadSums reads a technique's
+// sums; P has no scale: it is read as it is, or as 0 where there are no sums yet.
+MA_FN void loadPair(__global const float* sums, int pair, int l0, int paddedSize, float rescale, float16* sumP) {
+  for (int v = 0; v < MA_GRID_VECTORS; ++v)
+    sumP[v] = rescale == 0.0f ? (float16)0.0f
+                              : vload16(v, sums + pairSumIndex(pair, l0, MA_TECHNIQUES, paddedSize));
+}
+
+MA_FN void storePair(__global float* sums, int pair, int l0, int paddedSize, const float16* sumP) {
+  for (int v = 0; v < MA_GRID_VECTORS; ++v)
+    vstore16(sumP[v], v, sums + pairSumIndex(pair, l0, MA_TECHNIQUES, paddedSize));
 }
 
 // [HS14] Alg. 1 lines 5–13 for one pixel: adds the samples prepared at `prepared`
@@ -180,16 +217,25 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
     for (int v = 0; v < MA_GRID_VECTORS; ++v)
       for (int k = 0; k < MA_TECHNIQUES; ++k) alpha[v][k] = vload16(0, gridLanes + k * paddedSize + l0 + 16 * v);
     float16 sumG[MA_TECHNIQUES][MA_GRID_VECTORS], sumG2[MA_TECHNIQUES][MA_GRID_VECTORS];
+    float16 sumP[MA_PAIR_COUNT][MA_GRID_VECTORS];
     for (int j = 0; j < MA_TECHNIQUES; ++j) loadSums(sums, j, l0, paddedSize, rescale, sumG[j], sumG2[j]);
+#if MA_GRID_OPTIMAL_WEIGHTS
+    for (int pair = 0; pair < MA_PAIR_COUNT; ++pair) loadPair(sums, pair, l0, paddedSize, rescale, sumP[pair]);
+#endif
     if (rule == MA_RULE_MAX_ENTROPY) {
       for (int j = 0; j < MA_TECHNIQUES; ++j)
-        sumTechnique(prepared + preparedFirst(added, j) * (MA_TECHNIQUES + 1), added.nonZero[j], alpha, sumG[j],
-                     sumG2[j]);
+        sumTechnique(prepared + preparedFirst(added, j, MA_EVERY_SAMPLE) * (MA_TECHNIQUES + 1),
+                     preparedCount(added, j, MA_EVERY_SAMPLE), alpha, sumG[j], sumG2[j]);
     } else {
-      sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES), alpha, stageMix, sumG, sumG2[0]);
+      sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES, MA_EVERY_SAMPLE), alpha, stageMix, sumG, sumG2[0],
+                 sumP);
     }
-    if (keepSums)
+    if (keepSums) {
       for (int j = 0; j < MA_TECHNIQUES; ++j) storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
+#if MA_GRID_OPTIMAL_WEIGHTS
+      for (int pair = 0; pair < MA_PAIR_COUNT; ++pair) storePair(sums, pair, l0, paddedSize, sumP[pair]);
+#endif
+    }
     if (!rank) continue;
     for (int v = 0; v < MA_GRID_VECTORS; ++v) {
       float16 g1[MA_TECHNIQUES], g2[MA_TECHNIQUES];
@@ -217,7 +263,13 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
         }
         score = vload16(0, h);
       } else {
+#if MA_GRID_OPTIMAL_WEIGHTS
+        float16 p[MA_PAIR_COUNT];
+        for (int pair = 0; pair < MA_PAIR_COUNT; ++pair) p[pair] = sumP[pair][v];
+        score = optimalVarianceScore16(MA_TECHNIQUES, vload16(0, gridCost + l0 + 16 * v), g1, g2[0], p, invTotal);
+#else
         score = costVarianceScore16(MA_TECHNIQUES, alpha[v], vload16(0, gridCost + l0 + 16 * v), g1, g2[0], invTotal);
+#endif
       }
       vstore16(score, 0, scores + l0 + 16 * v);
       keepBetter(&best, score, index, gridSize);
@@ -227,7 +279,7 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
 }
 
 // One work-item per block of 16 pixels. `taken` samples per pixel are new since the
-// previous search; `summaries` (per pixel) and `sums` (runningSumIndex) hold what the
+// previous search; `summaries` (per pixel) and `sums` (sumRows rows per pixel) hold what the
 // searches before added; `keepSums` 0 leaves `sums` unwritten (no search follows), and
 // then the searches before must have added nothing. gridLanes[k · paddedSize + l] = α_{k,l} and gridCost[l] =
 // Σ_k c_k α_{k,l}, both padded past gridSize with the last combination; cost[k] = c_k;
@@ -261,13 +313,13 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
     all[lane] = mergeSummaries(before, added[lane]);
     fallbacks[lane] = pixelFallbacks(MA_TECHNIQUES, all[lane], rule);
     scale[lane] = sampleScale(all[lane]);
-    rescale[lane] = sumsRescale(before, scale[lane]);
-    for (int j = 0; j < MA_TECHNIQUES; ++j) next[lane][j] = preparedFirst(added[lane], j);
+    rescale[lane] = sumsRescale(before, scale[lane], MA_EVERY_SAMPLE);
+    for (int j = 0; j < MA_TECHNIQUES; ++j) next[lane][j] = preparedFirst(added[lane], j, MA_EVERY_SAMPLE);
   }
   for (int i = 0; i < taken; ++i)
     for (int lane = 0; lane < lanesUsed; ++lane)
-      if (hasSums(all[lane]))
-        prepareSample(blockSamples + lane, MA_TECHNIQUES, i, scale[lane], next[lane],
+      if (hasSums(all[lane], MA_EVERY_SAMPLE))
+        prepareSample(blockSamples + lane, MA_TECHNIQUES, i, scale[lane], MA_EVERY_SAMPLE, next[lane],
                       blockPrepared + lane * taken * (MA_TECHNIQUES + 1));
 
   float c[MA_TECHNIQUES];
@@ -275,9 +327,9 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
   for (int lane = 0; lane < lanesUsed; ++lane) {
     int pixel = 16 * block + lane, best = -1;
     // Pixels that cannot be ranked yet keep their sums for the searches to come.
-    if (hasSums(all[lane]))
+    if (hasSums(all[lane], MA_EVERY_SAMPLE))
       best = searchPixel(blockPrepared + lane * taken * (MA_TECHNIQUES + 1), added[lane], all[lane], rescale[lane],
-                         sums + runningSumIndex(pixel, 0, 0, 0, MA_TECHNIQUES, paddedSize), keepSums,
+                         sums + pixelSumsFirst(pixel, sumRows(MA_TECHNIQUES, MA_EVERY_SAMPLE), paddedSize), keepSums,
                          fallbacks[lane] == 0u, gridLanes, gridCost, gridSize, paddedSize, c, rule,
                          scoresOut + (size_t)pixel * paddedSize);
     // No combination could be ranked: non-finite sums, or for rule (a) no λ that

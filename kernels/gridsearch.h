@@ -116,23 +116,44 @@ MA_FN void summariseSample(PixelSummary* s, MA_GLOBAL const float* pixelSamples,
 // taken at one scale convert exactly to the next (sumsRescale).
 MA_FN float sampleScale(PixelSummary s) { return s.maxRatio > 0.0f ? inversePowerOfTwo(s.maxRatio) : 1.0f; }
 
-// A pixel keeps running sums once a valid sample has f > 0: until then they are all 0,
-// and after an invalid sample it falls back for good.
-MA_FN int hasSums(PixelSummary s) { return !s.invalid && s.maxRatio > 0.0f; }
+// With optimal weights ([Kon19], docs/methods.md) rule (b) also sums, over every sample,
+// f = 0 included, P_ik = Σ_x p_i p_k / (p_α q) (i ≤ k): n Ã_ik at the combination α
+// (optimalVarianceScore). `everySample` (MA_GRID_OPTIMAL_WEIGHTS in the kernel) says so.
+//
+// A pixel keeps running sums once a valid sample has f > 0 (with optimal weights, once
+// it has a valid sample): until then they are all 0, and after an invalid sample it
+// falls back for good.
+MA_FN int hasSums(PixelSummary s, int everySample) {
+  float n = 0.0f;
+  for (int k = 0; k < MA_GRID_MAX_TECHNIQUES; ++k) n += s.count[k];
+  return !s.invalid && (s.maxRatio > 0.0f || (everySample && n > 0.0f));
+}
 
 // The factor that takes Σ g from the scale of the samples summarised in `before` to
 // `scale` (its square takes Σ g²), or 0 where there are no sums yet. Both scales are
 // powers of two and the scale only falls as max_i f_i/Σ_k p_k grows, so the factor is
 // a power of two ≤ 1: exact, unless old sums underflow against a sample up to 2^126
 // times larger, where they no longer count.
-MA_FN float sumsRescale(PixelSummary before, float scale) {
-  return hasSums(before) ? scale / sampleScale(before) : 0.0f;
+// P has no scale (it holds no f) and is never rescaled.
+MA_FN float sumsRescale(PixelSummary before, float scale, int everySample) {
+  return hasSums(before, everySample) ? scale / sampleScale(before) : 0.0f;
 }
 
-// Where Σ g (moment 0) and Σ g² (moment 1) of technique j's samples at combination l
-// are kept: per pixel 2M rows of paddedSize floats.
-MA_FN size_t runningSumIndex(int pixel, int j, int moment, int l, int techniqueCount, int paddedSize) {
-  return (((size_t)pixel * techniqueCount + j) * 2 + moment) * paddedSize + l;
+// The pairs i ≤ k of P, row by row: P's upper triangle.
+#define MA_PAIRS(techniqueCount) ((techniqueCount) * ((techniqueCount) + 1) / 2)
+MA_FN int pairIndex(int i, int k, int techniqueCount) { return i * techniqueCount - i * (i - 1) / 2 + (k - i); }
+
+// A pixel's rows of paddedSize floats: Σ g (moment 0) and Σ g² (moment 1) of each
+// technique j's samples at every combination l, then with optimal weights P's pairs.
+MA_FN int sumRows(int techniqueCount, int everySample) {
+  return 2 * techniqueCount + (everySample ? MA_PAIRS(techniqueCount) : 0);
+}
+MA_FN size_t pixelSumsFirst(int pixel, int rows, int paddedSize) { return (size_t)pixel * rows * paddedSize; }
+MA_FN size_t runningSumIndex(int j, int moment, int l, int paddedSize) {
+  return ((size_t)j * 2 + moment) * paddedSize + l;
+}
+MA_FN size_t pairSumIndex(int pair, int l, int techniqueCount, int paddedSize) {
+  return ((size_t)2 * techniqueCount + pair) * paddedSize + l;
 }
 
 // All samples of a pixel so far: the n of rule (b).
@@ -164,25 +185,27 @@ MA_FN ma_uint pixelFallbacks(int techniqueCount, PixelSummary s, int rule) {
   return bits;
 }
 
-// The sums need only the samples with f > 0 (the others add 0), and read them grouped
-// by technique, so that the loop over one technique's samples runs without tests:
-// technique j's start after those of the techniques before it.
-MA_FN int preparedFirst(PixelSummary s, int j) {
+// The sums need only the samples with f > 0 (the others add 0; with optimal weights P
+// needs them all), and read them grouped by technique, so that the loop over one
+// technique's samples runs without tests: technique j's start after those of the
+// techniques before it.
+MA_FN int preparedCount(PixelSummary s, int j, int everySample) { return everySample ? (int)s.count[j] : s.nonZero[j]; }
+MA_FN int preparedFirst(PixelSummary s, int j, int everySample) {
   int first = 0;
-  for (int k = 0; k < j; ++k) first += s.nonZero[k];
+  for (int k = 0; k < j; ++k) first += preparedCount(s, k, everySample);
   return first;
 }
 
-// Copies sample i, if f > 0, to slot next[j]++ of `prepared` (M + 1 floats a slot,
+// Copies sample i, if f > 0 or `everySample`, to slot next[j]++ of `prepared` (M + 1 floats a slot,
 // next[j] starting at preparedFirst): f · scale · 2^−e, then p_k · 2^−e for every k,
 // with 2^−e = inversePowerOfTwo(Σ_k p_k). The common power of two leaves every
 // g = f/p_α exactly as it was and puts p_α in [min α, 2), so that a product of a few
 // p_α neither overflows nor underflows (MA_BATCH_QUOTIENTS).
-MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, float scale, int* next,
-                         MA_GLOBAL float* prepared) {
+MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount, int i, float scale, int everySample,
+                         int* next, MA_GLOBAL float* prepared) {
   float technique = storedValue(pixelSamples, techniqueCount, i, 0);
   float f = storedValue(pixelSamples, techniqueCount, i, 1);
-  if (f == 0.0f) return;
+  if (f == 0.0f && !everySample) return;
   int j = (int)technique;
   MA_GLOBAL float* out = prepared + (next[j]++) * (techniqueCount + 1);
   float pdf[MA_GRID_MAX_TECHNIQUES], pSum = 0.0f;
@@ -241,6 +264,44 @@ MA_FN void prepareSample(MA_GLOBAL const float* pixelSamples, int techniqueCount
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore, float)
 #ifdef __OPENCL_VERSION__
 MA_DEFINE_COST_VARIANCE_SCORE(costVarianceScore16, float16)
+#endif
+
+// Rule (b) with optimal weights: −(Σ_k c_k α_k) V_opt, V_opt = ∫ f²/p_α − b̃ᵀÃ⁻¹b̃ the
+// variance of the estimator with [Kon19]'s optimal weights at these counts, N = 1
+// (docs/methods.md; host/paper/OptimalWeightsVariance.h checks it by quadrature). With
+// the deterministic-mixture sums of costVarianceScore, b̃_j = M_j/n and Ã = P/n, so
+// V_opt = (S2 − Mᵀ P⁻¹ M)/n: Mᵀ P⁻¹ M by P's LDLᵀ and forward substitution. Each pivot
+// is kept at least MA_PIVOT_FLOOR of its diagonal: a P singular at float precision then
+// leaves its near-null direction out of the sum, which can only raise V_opt towards the
+// balance heuristic's. The sums are those of one pixel, M unknowns fitted to its own n
+// samples: V_opt is then low by about M/n of itself for every α alike, and the pooled
+// selection (PooledSelection) compares them summed over the window. Defined for T = float
+// and, in the kernel, T = float16.
+#define MA_PIVOT_FLOOR 1e-4f
+#define MA_DEFINE_OPTIMAL_VARIANCE_SCORE(name, T)                                                              \
+  MA_FN T name(int techniqueCount, T meanCost, const T* sumM, T sumS2, const T* sumP, float invCount) {        \
+    T L[MA_GRID_MAX_TECHNIQUES][MA_GRID_MAX_TECHNIQUES], d[MA_GRID_MAX_TECHNIQUES], y[MA_GRID_MAX_TECHNIQUES]; \
+    T quadratic = 0.0f;                                                                                        \
+    for (int i = 0; i < techniqueCount; ++i) {                                                                 \
+      T diagonal = sumP[pairIndex(i, i, techniqueCount)], pivot = diagonal, yi = sumM[i];                      \
+      for (int k = 0; k < i; ++k) {                                                                            \
+        pivot = ma_fma(-L[i][k] * d[k], L[i][k], pivot);                                                       \
+        yi = ma_fma(-L[i][k], y[k], yi);                                                                       \
+      }                                                                                                        \
+      d[i] = ma_max(pivot, MA_PIVOT_FLOOR * diagonal);                                                         \
+      y[i] = yi;                                                                                               \
+      quadratic = ma_fma(yi / d[i], yi, quadratic);                                                            \
+      for (int j = i + 1; j < techniqueCount; ++j) {                                                           \
+        T lji = sumP[pairIndex(i, j, techniqueCount)];                                                         \
+        for (int k = 0; k < i; ++k) lji = ma_fma(-L[j][k] * d[k], L[i][k], lji);                               \
+        L[j][i] = lji / d[i];                                                                                  \
+      }                                                                                                        \
+    }                                                                                                          \
+    return -(meanCost * ma_max((sumS2 - quadratic) * invCount, 0.0f));                                         \
+  }
+MA_DEFINE_OPTIMAL_VARIANCE_SCORE(optimalVarianceScore, float)
+#ifdef __OPENCL_VERSION__
+MA_DEFINE_OPTIMAL_VARIANCE_SCORE(optimalVarianceScore16, float16)
 #endif
 
 // The mixture weights of a batch of new samples: r_j = p_j/q and w = f/q with

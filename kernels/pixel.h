@@ -53,6 +53,8 @@ typedef struct {
   float y;        // Y(f)
   float pdfs[MA_MAX_TECHNIQUES];
   float sharePdfs[MA_MAX_BANK_SHARES];  // SampleValue::sharePdfs
+  float fr, fg, fb;  // f itself, for the optimal weights and their sums (stats.h)
+  float invP;        // 1/p_α (balance), 1/Σ_k p_k (count-independent); 0 where it is 0
 } SampleContribution;
 
 typedef struct {
@@ -111,7 +113,46 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) out.pdfs[k] = s.pdfs[k];
   MA_UNROLL
   for (int k = 0; k < MA_MAX_BANK_SHARES; ++k) out.sharePdfs[k] = s.sharePdfs[k];
+  out.fr = s.r;
+  out.fg = s.g;
+  out.fb = s.b;
+  out.invP = invP;
   return out;
+}
+
+// The coefficients a_{c,k} of [Kon19]'s optimal weights, per colour channel c and
+// technique k, solved per pixel from earlier stages (host/alloc/OptimalWeights.h); all 0
+// is the balance heuristic.
+typedef struct {
+  float a[3][MA_MAX_TECHNIQUES];
+} OptimalCoefficients;
+
+// [Kon19] Sec. 4 (docs/papers.md): with the optimal weights
+// w_t = a_t p_t/f + (n_t p_t / Σ_l n_l p_l)(1 − Σ_l a_l p_l/f), a sample of technique t
+// adds w_t f/(n_t p_t) = a_t/n_t + (f − Σ_l a_l p_l)/(N p_α): over the stage, Σ_k a_k plus
+// the balance heuristic of the residual f − Σ_l a_l p_l. Unbiased for any a, provided
+// every p_k integrates to 1 and every technique takes a sample (render/RunChecks.h). The
+// luminance value w becomes the residual's, Y(f − Σ_l a_l p_l)/p_α, whose per-technique
+// moments give the stage's variance as before (alloc/StageWeights.h). With a = 0 every
+// value is the balance heuristic's, bit for bit.
+MA_FN SampleContribution withOptimalWeights(SampleContribution s, StageCounts c, OptimalCoefficients k) {
+  float N = (float)c.stageSamples;
+  float nt = s.technique == 0 ? (float)c.n0 : (s.technique == 1 ? (float)c.n1 : (float)c.n2);
+  float f[3] = {s.fr, s.fg, s.fb}, residual[3], term[3];
+  MA_UNROLL
+  for (int ch = 0; ch < 3; ++ch) {
+    float ap = 0.0f;
+    MA_UNROLL
+    for (int l = 0; l < c.techniqueCount; ++l) ap = ma_fma(k.a[ch][l], s.pdfs[l], ap);
+    float at = s.technique == 0 ? k.a[ch][0] : (s.technique == 1 ? k.a[ch][1] : k.a[ch][2]);
+    residual[ch] = f[ch] - ap;
+    term[ch] = residual[ch] * s.invP / N + at / nt;
+  }
+  s.r = term[0];
+  s.g = term[1];
+  s.b = term[2];
+  s.w = luminance(residual[0], residual[1], residual[2]) * s.invP;
+  return s;
 }
 
 // Sample j of the stage. Multi-sample: the first n0 samples are technique 0's, the next

@@ -8,8 +8,9 @@
 // bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
 // (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
-// samples' share columns, kernels/stats.h; 0: none), MA_LOCAL_SIZE. Constants fold the
-// unused techniques, sampler, estimator and statistics away.
+// samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
+// weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE.
+// Constants fold the unused techniques, sampler, estimator and statistics away.
 //
 // No contraction of a*b + c into fma but where the code says fma: the C++ reference is
 // compiled with -ffp-contract=off too (CMakeLists.txt), so that a pixel's arithmetic is
@@ -17,6 +18,10 @@
 // It costs PoCL nothing measurable (README, "Sampling kernel against its OpenMP peer").
 #pragma OPENCL FP_CONTRACT OFF
 #include "stats.h"
+
+#if MA_OPTIMAL_WEIGHTS && (MA_ONE_SAMPLE || MA_COUNT_INDEPENDENT)
+#error "the optimal weights are those of the multi-sample estimator"
+#endif
 
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
 #define SAMPLE_COLUMNS MA_STORED_COLUMNS(MA_TECHNIQUES, MA_SHARE_COLUMNS)
@@ -43,8 +48,9 @@ enum {
   ROW_FIRST0,
   ROW_FIRST1,
   ROW_FIRST2,
-  ROW_COUNT
+  ROW_COEFFICIENTS  // --weights optimal: a_{c,k} at row ROW_COEFFICIENTS + c·M + k
 };
+#define ROW_COUNT (ROW_COEFFICIENTS + (MA_OPTIMAL_WEIGHTS ? 3 * MA_TECHNIQUES : 0))
 
 // Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
 // The envmap tables are read where the sample falls: they are the gathers that remain.
@@ -95,13 +101,24 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   c.first0 = (uint)PIXEL_ROW(ROW_FIRST0);
   c.first1 = (uint)PIXEL_ROW(ROW_FIRST1);
   c.first2 = (uint)PIXEL_ROW(ROW_FIRST2);
-#undef PIXEL_ROW
 #if MA_ONE_SAMPLE
   return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)(firstPixel + pixel));
 #else
-  return takeTechniqueSample(ts, env, b, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo, seedHi,
-                             (uint)(firstPixel + pixel));
+  SampleContribution s = takeTechniqueSample(ts, env, b, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo,
+                                             seedHi, (uint)(firstPixel + pixel));
+#if MA_OPTIMAL_WEIGHTS
+  OptimalCoefficients a;
+  MA_UNROLL
+  for (int ch = 0; ch < 3; ++ch) {
+    MA_UNROLL
+    for (int k = 0; k < MA_MAX_TECHNIQUES; ++k)
+      a.a[ch][k] = k < MA_TECHNIQUES ? as_float(PIXEL_ROW(ROW_COEFFICIENTS + ch * MA_TECHNIQUES + k)) : 0.0f;
+  }
+  s = withOptimalWeights(s, c, a);
 #endif
+  return s;
+#endif
+#undef PIXEL_ROW
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
@@ -109,7 +126,12 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
     float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
     uint seedLo, uint seedHi, int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
-    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity) {
+    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity
+#if MA_OPTIMAL_WEIGHTS
+    ,
+    __global const float* coefficients  // [pixel·3M + c·M + k]: a_{c,k} (kernels/pixel.h)
+#endif
+) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
@@ -122,18 +144,23 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
   StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                             MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  int rowValues[ROW_COUNT] = {as_int(brdfParams[4 * pixel + 0]),
-                              as_int(brdfParams[4 * pixel + 1]),
-                              as_int(brdfParams[4 * pixel + 2]),
-                              as_int(brdfParams[4 * pixel + 3]),
-                              pixelCounts.n0,
-                              pixelCounts.n1,
-                              pixelCounts.n2,
-                              (int)pixelCounts.first0,
-                              (int)pixelCounts.first1,
-                              (int)pixelCounts.first2};
+  int rowValues[ROW_COEFFICIENTS] = {as_int(brdfParams[4 * pixel + 0]),
+                                     as_int(brdfParams[4 * pixel + 1]),
+                                     as_int(brdfParams[4 * pixel + 2]),
+                                     as_int(brdfParams[4 * pixel + 3]),
+                                     pixelCounts.n0,
+                                     pixelCounts.n1,
+                                     pixelCounts.n2,
+                                     (int)pixelCounts.first0,
+                                     (int)pixelCounts.first1,
+                                     (int)pixelCounts.first2};
   MA_UNROLL
-  for (int r = 0; r < ROW_COUNT; ++r) pixelRows[r * MA_LOCAL_SIZE + lid] = rowValues[r];
+  for (int r = 0; r < ROW_COEFFICIENTS; ++r) pixelRows[r * MA_LOCAL_SIZE + lid] = rowValues[r];
+#if MA_OPTIMAL_WEIGHTS
+  MA_UNROLL
+  for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
+    pixelRows[(ROW_COEFFICIENTS + r) * MA_LOCAL_SIZE + lid] = as_int(coefficients[pixel * 3 * MA_TECHNIQUES + r]);
+#endif
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
   // sampler only. A work-group runs its largest n_k; the other work-items' surplus
@@ -169,7 +196,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       MA_UNROLL
       for (int s = 0; s < STAT_SLOTS; ++s) {
         int perTechnique = MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES);
-        running[s][lid] += counted && c.technique == s / perTechnique ? statValue(MA_STATS, s % perTechnique, c) : 0;
+        running[s][lid] +=
+            counted && c.technique == s / perTechnique ? statValue(MA_STATS, MA_TECHNIQUES, s % perTechnique, c) : 0;
       }
       if (MA_STORE_SAMPLES && counted && gid < pixelCount) {
         int i = firstSlot + j;

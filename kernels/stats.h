@@ -10,17 +10,27 @@
 #define MA_STATS_TECHNIQUE 1  // Σ f/p_k and Σ (f/p_k)²: V_k of [HS14] eq. 4.18 (heuristic)
 #define MA_STATS_BALANCE 2    // Σ f/Σ_l p_l and its square: σ_k of [SHS16] eq. 27–28 (σ/√c)
 #define MA_STATS_LINEAR 4     // F_k = Σ f and P_ik = Σ p_i: [SS23] eq. 18 (linear)
+#define MA_STATS_OPTIMAL 8    // Σ r_i r_k, Σ (f_c/p_α) r_i, r = p/p_α: [Kon19]'s A and b (optimal weights)
+
+// The optimal weights' sums per technique: the upper triangle of A, then b per channel.
+#define MA_OPTIMAL_SYSTEM_SUMS(techniqueCount) ((techniqueCount) * ((techniqueCount) + 1) / 2 + 3 * (techniqueCount))
 
 // Per technique: the count, then the sums that `mask` selects, in the order above; no
 // slot at all when the method keeps no sums. A macro: kernels size local arrays with it.
 #define MA_STATS_PER_TECHNIQUE(mask, techniqueCount)                                               \
   ((mask) == 0 ? 0                                                                                 \
                : 1 + (((mask)&MA_STATS_TECHNIQUE) ? 2 : 0) + (((mask)&MA_STATS_BALANCE) ? 2 : 0) + \
-                     (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0))
+                     (((mask)&MA_STATS_LINEAR) ? 1 + (techniqueCount) : 0) +                       \
+                     (((mask)&MA_STATS_OPTIMAL) ? MA_OPTIMAL_SYSTEM_SUMS(techniqueCount) : 0))
 
 // What sample s adds to slot `slot` of the sums of the technique that drew it. Squares
 // are taken in ma_acc: f/p can be near the top of the float range.
-MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
+//
+// The optimal weights' sums are count-free: a stage's samples x, drawn as the balance
+// heuristic's mixture p_α of its counts ([HS14] eq. 4.3), give Σ_x h(x)/p_α(x) ≈ N ∫ h, so
+// Σ_x p_i p_k/p_α² ≈ N ∫ p_i p_k/p_α = N Ã_ik and Σ_x f_c p_i/p_α² ≈ N b̃_ci: [Kon19]'s
+// A = Ã/N and b = b̃/N at that stage's counts (host/alloc/OptimalWeights.h).
+MA_FN ma_acc statValue(int mask, int techniqueCount, int slot, SampleContribution s) {
   float pt = s.technique == 0 ? s.pdfs[0] : (s.technique == 1 ? s.pdfs[1] : s.pdfs[2]);
   ma_acc w = pt > 0.0f ? (ma_acc)s.y / (ma_acc)pt : 0;
   float pSum = s.pdfs[0] + s.pdfs[1] + s.pdfs[2];
@@ -38,6 +48,24 @@ MA_FN ma_acc statValue(int mask, int slot, SampleContribution s) {
   if (mask & MA_STATS_LINEAR) {
     value = i == 0 ? (ma_acc)s.y : value;
     value = i == 1 ? (ma_acc)s.pdfs[0] : (i == 2 ? (ma_acc)s.pdfs[1] : (i == 3 ? (ma_acc)s.pdfs[2] : value));
+    i -= 1 + techniqueCount;
+  }
+  if (mask & MA_STATS_OPTIMAL) {
+    ma_acc r[MA_MAX_TECHNIQUES];
+    MA_UNROLL
+    for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) r[k] = (ma_acc)(s.pdfs[k] * s.invP);
+    ma_acc g[3] = {(ma_acc)(s.fr * s.invP), (ma_acc)(s.fg * s.invP), (ma_acc)(s.fb * s.invP)};
+    int entry = 0;
+    MA_UNROLL
+    for (int row = 0; row < techniqueCount; ++row) {
+      MA_UNROLL
+      for (int col = row; col < techniqueCount; ++col) value = i == entry++ ? r[row] * r[col] : value;
+    }
+    MA_UNROLL
+    for (int ch = 0; ch < 3; ++ch) {
+      MA_UNROLL
+      for (int k = 0; k < techniqueCount; ++k) value = i == entry++ ? g[ch] * r[k] : value;
+    }
   }
   return value;
 }

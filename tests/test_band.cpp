@@ -53,10 +53,20 @@ TEST_CASE("bands of whole block rows, their halo, and the shard option", "[band]
 
 TEST_CASE("merged bands are the unsharded render bit for bit, for every method", "[band][cli]") {
   TempDir dir("band");
-  std::vector<std::string> variants{
-      "equal", "envmap", "brdf", "heuristic", "sigma-sqrt-c", "linear", "oracle", "exact", "exact --stages 3 --pool 3"};
-  // Under the sanitizers: a fixed split and the widest halo, the same code paths.
-  if (smallTestSize()) variants = {"equal", "exact --stages 3 --pool 3"};
+  std::vector<std::string> variants{"equal",
+                                    "envmap",
+                                    "brdf",
+                                    "heuristic",
+                                    "sigma-sqrt-c",
+                                    "linear",
+                                    "oracle",
+                                    "exact",
+                                    "exact --stages 3 --pool 3",
+                                    "equal --weights optimal",
+                                    "exact --stages 3 --pool 3 --weights optimal"};
+  // Under the sanitizers: a fixed split, the widest halo and the optimal weights' pooled
+  // pilot, the same code paths.
+  if (smallTestSize()) variants = {"equal", "exact --stages 3 --pool 3", "equal --weights optimal"};
   for (const std::string& variant : variants) {
     const std::string method = variant.substr(0, variant.find(' '));
     const std::string extra = variant.size() > method.size() ? variant.substr(method.size()) : "";

@@ -18,6 +18,7 @@
 #include "TestDevice.h"
 #include "alloc/GridSearch.h"
 #include "paper/MixtureVariance.h"
+#include "paper/OptimalWeightsVariance.h"
 #include "paper/PaperExamples.h"
 #include "paper/Quadrature.h"
 
@@ -60,10 +61,12 @@ StoredSampleLayout layoutOf(const std::vector<PixelSampleList>& pixels, SampleCo
 
 // One search object per shape, reset before each use: building one compiles the kernel.
 GridSearch& deviceSearch(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize,
-                         bool runningSums = true) {
-  static std::map<std::tuple<int, int, int, int, bool>, std::unique_ptr<GridSearch>> searches;
-  auto& search = searches[{columns.techniqueCount, columns.shareColumns, pixelCount, gridSize, runningSums}];
-  if (!search) search = std::make_unique<GridSearch>(testDevice(), columns, pixelCount, gridSize, runningSums);
+                         bool runningSums = true, bool optimalWeights = false) {
+  static std::map<std::tuple<int, int, int, int, bool, bool>, std::unique_ptr<GridSearch>> searches;
+  auto& search =
+      searches[{columns.techniqueCount, columns.shareColumns, pixelCount, gridSize, runningSums, optimalWeights}];
+  if (!search)
+    search = std::make_unique<GridSearch>(testDevice(), columns, pixelCount, gridSize, runningSums, optimalWeights);
   search->reset();
   return *search;
 }
@@ -79,11 +82,12 @@ struct BothResults {
 
 BothResults searchBoth(const std::vector<PixelSampleList>& pixels, SampleColumns columns,
                        const std::vector<double>& costs, GridRule rule, int gridSize = kDefaultGridSize,
-                       int capacity = 0, const std::optional<PooledSelection>& pooling = std::nullopt) {
+                       int capacity = 0, const std::optional<PooledSelection>& pooling = std::nullopt,
+                       bool optimalWeights = false) {
   StoredSampleLayout layout = layoutOf(pixels, columns, std::max(capacity, int(pixels.front().size())));
   std::vector<float> samples = store(pixels, layout);
-  GridSearchReference reference(columns, layout.pixelCount, gridSize);
-  return {deviceSearch(columns, layout.pixelCount, gridSize)
+  GridSearchReference reference(columns, layout.pixelCount, gridSize, true, optimalWeights);
+  return {deviceSearch(columns, layout.pixelCount, gridSize, true, optimalWeights)
               .run(deviceBuffer(samples), layout, costs, rule, pooling),
           reference.run(samples, layout, costs, rule, pooling)};
 }
@@ -91,10 +95,11 @@ BothResults searchBoth(const std::vector<PixelSampleList>& pixels, SampleColumns
 // The same samples added in stages of `stageSize`, one search after each, as
 // host/render/Render.cpp runs them: the results of the last search.
 BothResults searchInStages(const std::vector<PixelSampleList>& pixels, int techniqueCount,
-                           const std::vector<double>& costs, GridRule rule, int stageSize) {
+                           const std::vector<double>& costs, GridRule rule, int stageSize,
+                           bool optimalWeights = false) {
   const int pixelCount = int(pixels.size()), total = int(pixels.front().size());
-  GridSearch& device = deviceSearch(techniqueCount, pixelCount);
-  GridSearchReference reference(techniqueCount, pixelCount);
+  GridSearch& device = deviceSearch(techniqueCount, pixelCount, kDefaultGridSize, true, optimalWeights);
+  GridSearchReference reference(techniqueCount, pixelCount, kDefaultGridSize, true, optimalWeights);
   BothResults r;
   for (int first = 0; first < total; first += stageSize) {
     std::vector<PixelSampleList> stage(pixelCount);
@@ -434,7 +439,8 @@ TEST_CASE("a search without running sums selects as one with them, and refuses a
   keeping.reset();
   CHECK(single.run(samples, layout, costs).selected == keeping.run(samples, layout, costs).selected);
   // The sums it leaves out: Σ g and Σ g² per technique for the 80 combinations.
-  CHECK(gridSearchBytesPerPixel(m, kDefaultGridSize, true) - gridSearchBytesPerPixel(m, kDefaultGridSize, false) ==
+  CHECK(gridSearchBytesPerPixel(m, kDefaultGridSize, true, false) -
+            gridSearchBytesPerPixel(m, kDefaultGridSize, false, false) ==
         2 * m * kDefaultGridSize * sizeof(float));
 }
 
@@ -549,4 +555,69 @@ TEST_CASE("with share columns each combination is judged by its own share's pdf"
   std::vector<float> samples = store(asShareColumns(pixels, shares, drawn, same), layout);
   CHECK_THROWS_AS(GridSearchReference(columns, width * height).run(samples, layout, costs, GridRule::MaxEntropy),
                   std::invalid_argument);
+}
+
+TEST_CASE("with optimal weights the kernel selects what the C++ reference selects", "[exact][weights]") {
+  // Rule (b) by the variance of [Kon19]'s optimal weights (kernels/gridsearch.h,
+  // optimalVarianceScore): its sums P over every sample, f = 0 included, and the LDLᵀ of
+  // each lane, the same float operations on both sides; in one search, pooled, and over
+  // stages whose running sums carry P.
+  for (int m : {2, 3}) {
+    const int pixels = 403;
+    auto data = randomPixels(m, pixels, 40, 17 + m);
+    std::vector<double> costs = m == 2 ? std::vector<double>{1.0, 2.5} : std::vector<double>{1.0, 2.5, 0.7};
+    const PooledSelection pooling{31, 13, 2, 0.02};
+    const BothResults results[] = {
+        searchBoth(data, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 48, std::nullopt, true),
+        searchBoth(data, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 48, pooling, true),
+        searchInStages(data, m, costs, GridRule::MinCostVariance, 10, true)};
+    for (const BothResults& r : results) {
+      int same = 0;
+      for (int p = 0; p < pixels; ++p)
+        same += r.device.selected[p] == r.reference.selected[p] &&
+                r.device.allocations[p].alpha == r.reference.allocations[p].alpha &&
+                r.device.varianceRatio[p] == r.reference.varianceRatio[p];
+      INFO(fmt::format("M = {}: {} of {} agree, {} fell back", m, same, pixels, r.reference.fallbackCount()));
+      CHECK(same == pixels);
+      CHECK(r.reference.fallbackCount() < pixels / 4);
+    }
+  }
+  // The entropy rule's Λ_j are the balance heuristic's.
+  auto data = randomPixels(2, 16, 10, 3);
+  StoredSampleLayout layout = layoutOf(data, 2, 10);
+  std::vector<float> samples = store(data, layout);
+  CHECK_THROWS_AS(
+      GridSearchReference(2, 16, kDefaultGridSize, true, true).run(samples, layout, {1.0, 1.0}, GridRule::MaxEntropy),
+      std::invalid_argument);
+}
+
+TEST_CASE("with optimal weights the minimum-variance rule finds the quadrature optimum of V_opt", "[exact][weights]") {
+  // f = x³ + 0.05 with p_0 = 1, p_1 = 2x on [0, 1]: V_opt(α) = ∫ f²/p_α − b̃ᵀÃ⁻¹b̃ by
+  // quadrature (paper/OptimalWeightsVariance.h) has its minimum inside the grid, and is
+  // flat there (0.02 % three steps away): the selection is judged by its V_opt. The
+  // balance heuristic's variance there is 3.6 times as large.
+  const Example1D example("x3", "f = x^3 + 0.05", 0, 1, [](double x) { return x * x * x + 0.05; },
+                          {Density1D(
+                               "1", [](double) { return 1.0; }, 0, 1),
+                           Density1D(
+                               "2x", [](double x) { return 2 * x; }, 0, 1)},
+                          {1.0, 1.0});
+  const std::vector<double> costs{1.0, 1.0};
+  const WeightGrid grid = makeWeightGrid(2, kDefaultGridSize, costs);
+  auto vOpt = [&](int l) {
+    return optimalWeightsVariance(example, {grid.alpha[2 * l], grid.alpha[2 * l + 1]}).variance.value;
+  };
+  int optimum = 0;
+  for (int l = 1; l < grid.size(); ++l)
+    if (vOpt(l) < vOpt(optimum)) optimum = l;
+  REQUIRE(optimum > 10);
+  REQUIRE(optimum < grid.size() - 10);
+  BothResults r = searchBoth({stratified([](double x) { return x * x * x + 0.05; }, 2, 2000)}, 2, costs,
+                             GridRule::MinCostVariance, kDefaultGridSize, 0, std::nullopt, true);
+  for (const GridSearchResult* result : {&r.device, &r.reference}) {
+    INFO(fmt::format("quadrature optimum l = {}, selected {}", optimum, result->selected[0]));
+    CHECK(vOpt(result->selected[0]) <= vOpt(optimum) * (1 + 1e-3));
+  }
+  CHECK(misalloc::multiSampleVariance(example, {grid.alpha[2 * optimum], grid.alpha[2 * optimum + 1]}).value >
+        3 * vOpt(optimum));
 }

@@ -30,7 +30,7 @@ int statSlotsOf(Method method, bool split) {
 }
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
-  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true); };
+  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, 0); };
 }
 
 bool hasFp64(const cl::Device& device) {
@@ -41,9 +41,10 @@ bool hasFp64(const cl::Device& device) {
 
 TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pixel's rows, the pass counts",
           "[launch]") {
-  CHECK(sampleKernelLocalBytes(8, 0, true) == 8 * (9 * 8 + 11 * 4));
-  CHECK(sampleKernelLocalBytes(256, 15, true) == 256 * (24 * 8 + 11 * 4));
-  CHECK(sampleKernelLocalBytes(64, 6, false) == 64 * (15 * 4 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(8, 0, true, 0) == 8 * (9 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(256, 15, true, 0) == 256 * (24 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(64, 6, false, 0) == 64 * (15 * 4 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(8, 20, true, 6) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
 }
 
 TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
@@ -113,16 +114,20 @@ TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the b
   const bool doubleSums = hasFp64(device.device);
   for (bool split : {false, true}) {
     Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split);
-    for (Method method : {Method::Equal, Method::Heuristic, Method::Linear}) {
-      SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 64, AdaptiveOptions{});
-      const int statSlots = HostSampler(scene, config).statSlots();
-      for (int localSize : {8, 64}) {
-        CAPTURE(split, methodName(method), localSize);
-        cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)),
-                          "sampleStage");
-        CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
-              sampleKernelLocalBytes(localSize, statSlots, doubleSums));
+    for (Method method : {Method::Equal, Method::Heuristic, Method::Linear})
+      for (MisWeights weights : {MisWeights::Balance, MisWeights::Optimal}) {
+        AdaptiveOptions options;
+        options.weights = weights;
+        SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 64, options);
+        const int statSlots = HostSampler(scene, config).statSlots();
+        const int coefficientRows = weights == MisWeights::Optimal ? 3 * scene.techniqueCount() : 0;
+        for (int localSize : {8, 64}) {
+          CAPTURE(split, methodName(method), misWeightsName(weights), localSize);
+          cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)),
+                            "sampleStage");
+          CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
+                sampleKernelLocalBytes(localSize, statSlots, doubleSums, coefficientRows));
+        }
       }
-    }
   }
 }

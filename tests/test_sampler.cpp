@@ -26,14 +26,20 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 
 // Neither compiler contracts a*b + c (kernels/sample.cl), so PoCL and g++ compute the
 // same floats in the same order: equal bit for bit. The optimal pdf's bank (M = 2 only)
-// is read through every BRDF bin of the grid and, as the counts vary, every share.
+// is read through every BRDF bin of the grid and, as the counts vary, every share. The
+// optimal weights ([Kon19]) run with coefficients of both signs that differ per pixel.
 TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler]") {
+  SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
+  shareColumns.shareColumns = true;  // with the optimal pdf
+  SamplerConfig optimalWeights{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_OPTIMAL, 100};
+  optimalWeights.optimalWeights = true;
   const SamplerConfig configs[] = {
       {Estimator::MultiSample, 0, 0},
       {Estimator::OneSample, 0, 0},
       {Estimator::CountIndependent, MA_STATS_BALANCE, 0},
       {Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 100},
-      {Estimator::MultiSample, 0, 100, kDefaultGridSize, false, true},  // share columns with the optimal pdf
+      shareColumns,
+      optimalWeights,
   };
   for (const char* pdf : {"plain", "optimal"}) {
     for (bool split : {false, true}) {
@@ -53,6 +59,10 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler
             n[M - 1] = 50 - n[0] - (M - 2) * (1 + p % 3);
             if (M == 3) n[1] = 1 + p % 3;
           }
+          plan.optimalCoefficients.clear();
+          if (config.optimalWeights)
+            for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)
+              plan.optimalCoefficients.push_back(0.02f * float(int(i * 37 % 101) - 50));
           Sampler device(testDevice(), scene, config);
           HostSampler host(scene, config);
           size_t mismatches = 0;
@@ -70,8 +80,9 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler
           std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
           REQUIRE(storedA.size() == storedB.size());
           for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
-          INFO(fmt::format("{} split {} cdf {} estimator {} stats {} stored {}", pdf, split, s == EnvmapSampler::Cdf,
-                           int(config.estimator), config.statsMask, config.sampleCapacity));
+          INFO(fmt::format("{} split {} cdf {} estimator {} stats {} stored {} optimal weights {}", pdf, split,
+                           s == EnvmapSampler::Cdf, int(config.estimator), config.statsMask, config.sampleCapacity,
+                           config.optimalWeights));
           CHECK(mismatches == 0);
         }
       }

@@ -37,6 +37,14 @@ void checkColumns(SampleColumns columns) {
                                             columns.techniqueCount, columns.count(), kMaxTechniques));
 }
 
+// [Kon19]'s variance is the system of the techniques' pdfs; a share column is a pdf the
+// stage may not run (the sampler stores share columns with balance weights only).
+void checkColumns(SampleColumns columns, bool optimalWeights) {
+  checkColumns(columns);
+  if (optimalWeights && columns.shareColumns > 0)
+    throw std::invalid_argument("grid search: optimal weights on samples with share columns");
+}
+
 void checkLayout(const StoredSampleLayout& layout, SampleColumns columns, int pixelCount, std::size_t availableFloats) {
   if (layout.columns != columns.count())
     throw std::invalid_argument(fmt::format("grid search: samples of {} columns, search built for {}",
@@ -83,14 +91,16 @@ int closestResolution(int techniqueCount, int approximateSize) {
 int paddedGridSize(int gridSize) { return (gridSize + kPass - 1) / kPass * kPass; }
 
 // Floats of running sums per pixel: Σ g and Σ g² for every technique and combination
-// of the grid makeWeightGrid makes (and validates), padded to whole passes.
+// of the grid makeWeightGrid makes (and validates), padded to whole passes, and with
+// optimal weights P's pairs.
 // The grid's combinations (not its costs): makeWeightGrid with unit costs.
 WeightGrid gridFor(SampleColumns columns, int gridSize) {
   return makeWeightGrid(columns, gridSize, std::vector<double>(columns.techniqueCount, 1.0));
 }
 
-std::size_t runningSumFloats(SampleColumns columns, int gridSize) {
-  return std::size_t(2) * columns.count() * paddedGridSize(gridFor(columns, gridSize).size());
+std::size_t runningSumFloats(SampleColumns columns, int gridSize, bool optimalWeights) {
+  return std::size_t(kern::sumRows(columns.count(), optimalWeights ? 1 : 0)) *
+         paddedGridSize(gridFor(columns, gridSize).size());
 }
 
 // The grid's combination nearest to α_k = 1/M, against which the skip rule weighs.
@@ -104,6 +114,12 @@ int nearestEqual(const WeightGrid& grid) {
     if (d < bestDistance) bestDistance = d, best = l;
   }
   return best;
+}
+
+// The entropy rule's Λ_j ([HS14] eq. 4.16) are the balance heuristic's.
+void checkRule(GridRule rule, bool optimalWeights) {
+  if (optimalWeights && rule == GridRule::MaxEntropy)
+    throw std::invalid_argument("grid search: rule (a) ranks the balance heuristic, not the optimal weights");
 }
 
 // A search that keeps no running sums cannot add to those of a search before it.
@@ -192,55 +208,60 @@ struct SearchSetup {
   LaneGrid lanes;
   std::vector<float> cost;  // c_k
   int rule;
+  bool optimalWeights;  // rule (b) by the variance with [Kon19]'s optimal weights
 };
 
-// Adds the new samples to the running sums at `sums` (runningSumIndex) for every
+// Adds the new samples to the running sums at `sums` (sumRows rows) for every
 // combination l, the sums first brought to the current scale: the kernel's loadSums,
-// sumTechnique or sumMixture and storeSums as plain loops, with the same operations in
-// the same order. Rule (a): Σ g and Σ g² of each technique's samples ([HS14] Alg. 1 line
-// 8); rule (b): M_j and S2 (kernels/gridsearch.h, costVarianceScore).
+// loadPair, sumTechnique or sumMixture and storeSums, storePair as plain loops, with the
+// same operations in the same order. Rule (a): Σ g and Σ g² of each technique's samples
+// ([HS14] Alg. 1 line 8); rule (b): M_j and S2 (kernels/gridsearch.h, costVarianceScore)
+// and, with optimal weights, P (optimalVarianceScore).
 template <int M>
 void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const float* prepared, float rescale,
               float* sums) {
-  const int padded = setup.lanes.paddedSize;
+  const int padded = setup.lanes.paddedSize, every = setup.optimalWeights ? 1 : 0;
   const float* alpha = setup.lanes.alpha.data();
   const float rescale2 = rescale * rescale;
   for (int j = 0; j < M; ++j) {
-    float* s = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
-    float* s2 = sums + kern::runningSumIndex(0, j, 1, 0, M, padded);
+    float* s = sums + kern::runningSumIndex(j, 0, 0, padded);
+    float* s2 = sums + kern::runningSumIndex(j, 1, 0, padded);
     for (int l = 0; l < padded; ++l) {
       s[l] = rescale == 0.0f ? 0.0f : s[l] * rescale;
       s2[l] = rescale == 0.0f ? 0.0f : s2[l] * rescale2;
     }
   }
-  // g of sample x at the 16 combinations of lane block l0 + 16 v, batched as the kernel
-  // batches them.
-  auto quotients = [&](const float* x, int l0, int lane, float(&g)[kGridVectors]) {
+  if (every)
+    for (int pair = 0; pair < MA_PAIRS(M); ++pair)
+      if (rescale == 0.0f) std::fill_n(sums + kern::pairSumIndex(pair, 0, M, padded), padded, 0.0f);
+  // numerator/p_α of sample x at the 16 combinations of lane block l0 + 16 v, batched as
+  // the kernel batches them.
+  auto quotients = [&](const float* x, float numerator, int l0, int lane, float(&g)[kGridVectors]) {
     float p[kGridVectors];
     for (int v = 0; v < kGridVectors; ++v) {
       int l = l0 + 16 * v + lane;
       p[v] = alpha[l] * x[1];
       for (int k = 1; k < M; ++k) p[v] = std::fma(alpha[k * padded + l], x[1 + k], p[v]);
     }
-    MA_BATCH_QUOTIENTS(float, kGridVectors, x[0], p, g);
+    MA_BATCH_QUOTIENTS(float, kGridVectors, numerator, p, g);
   };
-  // add(l, g) for g of sample x at every combination l, lanes vectorised.
-  auto forEachQuotient = [&](const float* x, auto add) {
+  // add(l, q) for q = numerator/p_α of sample x at every combination l, lanes vectorised.
+  auto forEachQuotient = [&](const float* x, float numerator, auto add) {
     for (int l0 = 0; l0 < padded; l0 += kPass)
 #pragma omp simd
       for (int lane = 0; lane < 16; ++lane) {
         float g[kGridVectors];
-        quotients(x, l0, lane, g);
+        quotients(x, numerator, l0, lane, g);
         for (int v = 0; v < kGridVectors; ++v) add(l0 + 16 * v + lane, g[v]);
       }
   };
   if (setup.rule == MA_RULE_MAX_ENTROPY) {
     for (int j = 0; j < M; ++j) {
-      float* s = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
-      float* s2 = sums + kern::runningSumIndex(0, j, 1, 0, M, padded);
-      const float* x = prepared + kern::preparedFirst(added, j) * (M + 1);
-      for (int i = 0; i < added.nonZero[j]; ++i, x += M + 1)
-        forEachQuotient(x, [&](int l, float g) {
+      float* s = sums + kern::runningSumIndex(j, 0, 0, padded);
+      float* s2 = sums + kern::runningSumIndex(j, 1, 0, padded);
+      const float* x = prepared + kern::preparedFirst(added, j, every) * (M + 1);
+      for (int i = 0; i < kern::preparedCount(added, j, every); ++i, x += M + 1)
+        forEachQuotient(x, x[0], [&](int l, float g) {
           s[l] += g;
           s2[l] = std::fma(g, g, s2[l]);
         });
@@ -249,16 +270,30 @@ void sumPixel(const SearchSetup& setup, const kern::PixelSummary& added, const f
   }
   float stageMix[M];
   kern::stageMixture(M, added, stageMix);
-  float* sumS2 = sums + kern::runningSumIndex(0, 0, 1, 0, M, padded);
+  float* sumS2 = sums + kern::runningSumIndex(0, 1, 0, padded);
   float* sumM[M];
-  for (int j = 0; j < M; ++j) sumM[j] = sums + kern::runningSumIndex(0, j, 0, 0, M, padded);
+  for (int j = 0; j < M; ++j) sumM[j] = sums + kern::runningSumIndex(j, 0, 0, padded);
+  float* sumP[MA_PAIRS(M)];
+  for (int pair = 0; pair < MA_PAIRS(M); ++pair) sumP[pair] = sums + kern::pairSumIndex(pair, 0, M, padded);
   const float* x = prepared;
-  for (int i = 0; i < kern::preparedFirst(added, M); ++i, x += M + 1) {
+  for (int i = 0; i < kern::preparedFirst(added, M, every); ++i, x += M + 1) {
     float r[M];
     const float w = kern::mixtureWeights(M, stageMix, x, r);
-    forEachQuotient(x, [&](int l, float g) {
+    auto addMixture = [&](int l, float g) {
       sumS2[l] = std::fma(g, w, sumS2[l]);
       for (int j = 0; j < M; ++j) sumM[j][l] = std::fma(g, r[j], sumM[j][l]);
+    };
+    if (!every) {
+      forEachQuotient(x, x[0], addMixture);
+      continue;
+    }
+    forEachQuotient(x, 1.0f, [&](int l, float inverse) {
+      int pair = 0;
+      for (int a = 0; a < M; ++a) {
+        const float t = inverse * x[1 + a];
+        for (int b = a; b < M; ++b, ++pair) sumP[pair][l] = std::fma(t, r[b], sumP[pair][l]);
+      }
+      addMixture(l, inverse * x[0]);
     });
   }
 }
@@ -284,13 +319,17 @@ int bestCombination(const SearchSetup& setup, const kern::PixelSummary& all, con
   const float invTotal = 1.0f / kern::sampleCount(m, all);
   int best = -1;
   for (int l = 0; l < setup.grid.size(); ++l) {
-    float g1[kMaxTechniques], g2[kMaxTechniques];
+    float g1[kMaxTechniques], g2[kMaxTechniques], p[MA_PAIRS(kMaxTechniques)];
     for (int j = 0; j < m; ++j) {
-      g1[j] = sums[kern::runningSumIndex(0, j, 0, l, m, padded)];
-      g2[j] = sums[kern::runningSumIndex(0, j, 1, l, m, padded)];
+      g1[j] = sums[kern::runningSumIndex(j, 0, l, padded)];
+      g2[j] = sums[kern::runningSumIndex(j, 1, l, padded)];
     }
-    float score = kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(), g1,
-                                  g2, invCount, invTotal);
+    for (int pair = 0; setup.optimalWeights && pair < MA_PAIRS(m); ++pair)
+      p[pair] = sums[kern::pairSumIndex(pair, l, m, padded)];
+    float score = setup.optimalWeights && setup.rule == MA_RULE_MIN_COST_VARIANCE
+                      ? kern::optimalVarianceScore(m, setup.grid.cost[l], g1, g2[0], p, invTotal)
+                      : kern::gridScore(setup.rule, m, &setup.grid.alpha[l * m], setup.grid.cost[l], setup.cost.data(),
+                                        g1, g2, invCount, invTotal);
     scores[l] = score;
     if (score > bestScore) {
       bestScore = score;
@@ -315,11 +354,13 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
   int best = -1;
   scale = kern::sampleScale(all);
   // Pixels that cannot be ranked yet keep their sums for the searches to come.
-  if (kern::hasSums(all)) {
+  const int every = setup.optimalWeights ? 1 : 0;
+  if (kern::hasSums(all, every)) {
     int next[kMaxTechniques];
-    for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(added, j);
-    for (int i = 0; i < setup.layout.taken; ++i) kern::prepareSample(pixelSamples, m, i, scale, next, prepared.data());
-    sumPixel(setup, added, prepared.data(), kern::sumsRescale(summary, scale), sums);
+    for (int j = 0; j < m; ++j) next[j] = kern::preparedFirst(added, j, every);
+    for (int i = 0; i < setup.layout.taken; ++i)
+      kern::prepareSample(pixelSamples, m, i, scale, every, next, prepared.data());
+    sumPixel(setup, added, prepared.data(), kern::sumsRescale(summary, scale, every), sums);
     if (fallbacks == 0) best = bestCombination(setup, all, sums, scores);
   }
   if (fallbacks == 0 && best < 0)
@@ -434,14 +475,15 @@ WeightGrid makeWeightGrid(SampleColumns columns, int approximateSize, const std:
   return grid;
 }
 
-std::string gridSearchKernelOptions(SampleColumns columns) {
-  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SHARE_COLUMNS={} -DMA_GRID_VECTORS={}", columns.count(),
-                     columns.shareColumns, kGridVectors);
+std::string gridSearchKernelOptions(SampleColumns columns, bool optimalWeights) {
+  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SHARE_COLUMNS={} -DMA_GRID_VECTORS={} "
+                     "-DMA_GRID_OPTIMAL_WEIGHTS={}",
+                     columns.count(), columns.shareColumns, kGridVectors, optimalWeights ? 1 : 0);
 }
 
-std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums) {
+std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums, bool optimalWeights) {
   const std::size_t scoreFloats = paddedGridSize(gridFor(columns, gridSize).size()) + 1;  // and the scale
-  const std::size_t sumFloats = runningSums ? runningSumFloats(columns, gridSize) : 0;
+  const std::size_t sumFloats = runningSums ? runningSumFloats(columns, gridSize, optimalWeights) : 0;
   return (sumFloats + scoreFloats) * sizeof(float) + sizeof(kern::PixelSummary);
 }
 
@@ -450,10 +492,16 @@ int GridSearchResult::fallbackCount() const {
       std::count_if(allocations.begin(), allocations.end(), [](const Allocation& a) { return a.usedFallback(); }));
 }
 
-GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize, bool runningSums)
-    : device_(device), columns_(columns), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
-  checkColumns(columns);
-  cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(columns));
+GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize, bool runningSums,
+                       bool optimalWeights)
+    : device_(device),
+      columns_(columns),
+      pixelCount_(pixelCount),
+      gridSize_(gridSize),
+      runningSums_(runningSums),
+      optimalWeights_(optimalWeights) {
+  checkColumns(columns, optimalWeights);
+  cl::Program program = buildProgram(device, "gridsearch.cl", gridSearchKernelOptions(columns, optimalWeights));
   kernel_ = cl::Kernel(program, "gridSearch");
   poolKernel_ = cl::Kernel(program, "selectPooled");
   // OpenCL buffers cannot be empty.
@@ -462,7 +510,8 @@ GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCou
   // Only pixels with hasSums read their sums, so reset() leaves them; they are written
   // once here so that the first search does not pay a page fault per 4 KiB of them.
   // Without running sums the kernel reads and writes none: one float stands in.
-  const std::size_t sumBytes = (runningSums ? pixels * runningSumFloats(columns, gridSize) : 1) * sizeof(float);
+  const std::size_t sumBytes =
+      (runningSums ? pixels * runningSumFloats(columns, gridSize, optimalWeights) : 1) * sizeof(float);
   sums_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, sumBytes);
   device.queue.enqueueFillBuffer(sums_, cl_uchar(0), 0, sumBytes);
   const std::size_t scoreBytes = pixels * paddedGridSize(gridFor(columns, gridSize).size()) * sizeof(float);
@@ -490,6 +539,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   checkLayout(layout, columns_, pixelCount_, samples.getInfo<CL_MEM_SIZE>() / sizeof(float));
   checkRule(rule, columns_);
   checkPooling(pooling, rule, pixelCount_);
+  checkRule(rule, optimalWeights_);
   checkRunningSums(runningSums_, added_);
   added_ = added_ || layout.taken > 0;
   WeightGrid grid = makeWeightGrid(columns_, gridSize_, costs);
@@ -561,12 +611,17 @@ struct GridSearchReference::RunningSums {
   std::vector<float> scores, scales;  // the last search's, as the kernel keeps them
 };
 
-GridSearchReference::GridSearchReference(SampleColumns columns, int pixelCount, int gridSize, bool runningSums)
-    : columns_(columns), pixelCount_(pixelCount), gridSize_(gridSize), runningSums_(runningSums) {
-  checkColumns(columns);
+GridSearchReference::GridSearchReference(SampleColumns columns, int pixelCount, int gridSize, bool runningSums,
+                                         bool optimalWeights)
+    : columns_(columns),
+      pixelCount_(pixelCount),
+      gridSize_(gridSize),
+      runningSums_(runningSums),
+      optimalWeights_(optimalWeights) {
+  checkColumns(columns, optimalWeights);
   running_ = std::make_unique<RunningSums>();
   if (runningSums)
-    running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(columns, gridSize));
+    running_->sums.resize(std::size_t(std::max(0, pixelCount)) * runningSumFloats(columns, gridSize, optimalWeights));
   reset();
 }
 
@@ -583,12 +638,13 @@ GridSearchResult GridSearchReference::run(const std::vector<float>& samples, con
   checkLayout(layout, columns_, pixelCount_, samples.size());
   checkRule(rule, columns_);
   checkPooling(pooling, rule, pixelCount_);
+  checkRule(rule, optimalWeights_);
   checkRunningSums(runningSums_, added_);
   added_ = added_ || layout.taken > 0;
   WeightGrid grid = makeWeightGrid(columns_, gridSize_, costs);
-  SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule)};
+  SearchSetup setup{samples.data(), layout, grid, laneGrid(grid), toFloats(costs), kernelRule(rule), optimalWeights_};
   const int m = columns_.count(), pixels = layout.pixelCount, padded = setup.lanes.paddedSize;
-  const std::size_t pixelSums = std::size_t(2) * m * padded;
+  const std::size_t pixelSums = std::size_t(kern::sumRows(m, optimalWeights_ ? 1 : 0)) * padded;
   std::vector<float>& scores = running_->scores;
   std::vector<float>& scales = running_->scales;
   scores.resize(std::size_t(pixels) * padded);

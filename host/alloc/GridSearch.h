@@ -54,15 +54,16 @@ struct WeightGrid {
 // size < 1 or an invalid cost (validateCosts; one per technique).
 WeightGrid makeWeightGrid(SampleColumns columns, int approximateSize, const std::vector<double>& costs);
 
-// The `-D` options that compile kernels/gridsearch.cl for these columns. The grid, its
+// The `-D` options that compile kernels/gridsearch.cl for these columns, with rule (b)
+// ranking the variance of [Kon19]'s optimal weights where `optimalWeights`. The grid, its
 // rule and the pooling are kernel arguments: one program serves them all.
-std::string gridSearchKernelOptions(SampleColumns columns);
+std::string gridSearchKernelOptions(SampleColumns columns, bool optimalWeights);
 
 // What a search keeps per pixel from run to run: Σ g and Σ g² for every column and
 // combination (the grid padded to whole passes) where it keeps running sums, the
 // summary of the samples, and the last search's scores and scale for the pooled
-// selection.
-std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums);
+// selection; with optimal weights also P's pairs per combination.
+std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums, bool optimalWeights);
 
 // Rule (b)'s selection over neighbourhoods (Pooling.h says why) and the skip
 // rule, for the pixels of a width × height image: each pixel takes the combination
@@ -101,11 +102,15 @@ struct GridSearchResult {
 // since reset() throws std::logic_error.
 // A scratch buffer of taken · (C + 1) floats per pixel, for the new samples as the sums
 // read them, is kept from run to run. The allocations it returns are per technique.
+// With `optimalWeights`, rule (b) ranks each combination by the variance of the
+// estimator with [Kon19]'s optimal weights at those counts (kernels/gridsearch.h,
+// optimalVarianceScore), and rule (a) is refused.
 class GridSearch {
  public:
-  // Throws std::invalid_argument for columns that makeWeightGrid rejects or a grid size < 1.
+  // Throws std::invalid_argument for columns that makeWeightGrid rejects, share columns
+  // with optimal weights, or a grid size < 1.
   GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize,
-             bool runningSums = true);
+             bool runningSums = true, bool optimalWeights = false);
 
   // Throws std::invalid_argument for a layout that does not match the columns, the
   // pixel count or the buffer, taken > capacity, costs that makeWeightGrid rejects,
@@ -121,7 +126,7 @@ class GridSearch {
   const Device& device_;
   SampleColumns columns_;
   int pixelCount_, gridSize_;
-  bool runningSums_;
+  bool runningSums_, optimalWeights_;
   bool added_ = false;  // a search since reset() added samples
   cl::Kernel kernel_, poolKernel_;
   cl::Buffer summaries_, sums_, prepared_, scores_, scales_;
@@ -133,7 +138,8 @@ class GridSearch {
 // running sums in host memory.
 class GridSearchReference {
  public:
-  GridSearchReference(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true);
+  GridSearchReference(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true,
+                      bool optimalWeights = false);
   ~GridSearchReference();
 
   GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
@@ -145,7 +151,7 @@ class GridSearchReference {
   struct RunningSums;  // kernels/gridsearch.h's types, which this header does not include
   SampleColumns columns_;
   int pixelCount_, gridSize_;
-  bool runningSums_;
+  bool runningSums_, optimalWeights_;
   bool added_ = false;
   std::unique_ptr<RunningSums> running_;
 };

@@ -22,6 +22,15 @@ struct KeptGridSearch final : StageStatistics::Kept {
   void reset() { device ? device->reset() : host->reset(); }
 };
 
+// Rule (b) ranks the optimal weights' variance where the config asks for them, but not
+// with the optimal envmap pdf's bank: there the stage's own envmap pdf depends on α
+// (kernels/envmap.h, bankEntryOf), while the samples hold the pdf of the table they were
+// drawn from, and a stage whose table differs keeps the balance heuristic
+// (OptimalWeights.h, kWeightsOtherEnvmapTable), which its α must then suit.
+bool ranksOptimalWeights(const StageStatistics& stages) {
+  return stages.config().optimalWeights && !stages.scene().tables.hasBank();
+}
+
 KeptGridSearch& keptSearch(StageStatistics& stages) {
   if (auto* kept = dynamic_cast<KeptGridSearch*>(stages.kept().get())) return *kept;
   const Scene& scene = stages.scene();
@@ -30,14 +39,14 @@ KeptGridSearch& keptSearch(StageStatistics& stages) {
   if (const Device* device = stages.storedSampleDevice()) {
     try {
       kept->device = std::make_unique<GridSearch>(*device, sampleColumns(scene, config), scene.pixelCount(),
-                                                  config.gridSize, config.runningSums);
+                                                  config.gridSize, config.runningSums, ranksOptimalWeights(stages));
     } catch (const cl::Error& e) {
       // The grid's sums and scores are the search's largest buffers.
       throw explainBufferError(e, *device, fmt::format("--grid-u {}", config.gridSize), scene.pixelCount());
     }
   } else {
     kept->host = std::make_unique<GridSearchReference>(sampleColumns(scene, config), scene.pixelCount(),
-                                                       config.gridSize, config.runningSums);
+                                                       config.gridSize, config.runningSums, ranksOptimalWeights(stages));
   }
   stages.kept() = std::move(kept);
   return static_cast<KeptGridSearch&>(*stages.kept());
@@ -51,7 +60,8 @@ GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, GridRule rule,
   if (config.gridSize <= 0 || config.sampleCapacity <= 0)
     throw std::logic_error("grid search on a sampler that does not keep what it needs");
   keptSearch(stages).reset();
-  bytesPerPixel_ = gridSearchBytesPerPixel(sampleColumns(stages.scene(), config), config.gridSize, config.runningSums);
+  bytesPerPixel_ = gridSearchBytesPerPixel(sampleColumns(stages.scene(), config), config.gridSize, config.runningSums,
+                                           ranksOptimalWeights(stages));
 }
 
 StageAllocation GridSearchAllocator::allocate(StageStatistics& stages, const std::vector<double>& costs) {

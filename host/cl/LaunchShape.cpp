@@ -14,8 +14,9 @@ namespace {
 
 // kernels/sample.cl's SUM_COUNT: R, G, B, and per technique Σ w and Σ w².
 constexpr size_t kSampleSums = 9;
-// kernels/sample.cl's ROW_COUNT: the pixel's BRDF, BRDF bin, counts and first indices,
-// 32-bit words read once before the sample loop.
+// kernels/sample.cl's ROW_COEFFICIENTS: the pixel's BRDF, BRDF bin, counts and first
+// indices, 32-bit words read once before the sample loop (the optimal weights'
+// coefficients follow them).
 constexpr size_t kPixelRows = 10;
 
 // PoCL vectorises a work-group across 8 work-items fastest (docs/pocl.md, rule 4).
@@ -61,9 +62,10 @@ DeviceLimits deviceLimits(const cl::Device& device) {
   return limits;
 }
 
-size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums) {
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int coefficientRows) {
   const size_t acc = doubleSums ? sizeof(double) : sizeof(float);
-  return size_t(localSize) * ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + 1) * sizeof(cl_int));
+  return size_t(localSize) *
+         ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + size_t(coefficientRows) + 1) * sizeof(cl_int));
 }
 
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,

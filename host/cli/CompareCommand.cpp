@@ -30,6 +30,7 @@
 #include "compare/Suite.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
+#include "compare/WeightsComparison.h"
 #include "render/Reference.h"
 
 namespace misalloc {
@@ -41,7 +42,7 @@ struct CompareArgs {
   AdaptiveArgs adaptive;
   DeviceArgs devices;
   CompareOptions compare;
-  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal", shard;
+  std::string methods = "all", budgets = "50,100,200,400,800", envmapPdfs = "plain,optimal", weights = "balance", shard;
   std::string shardUnit = "scene";
   bool suite = false;
 };
@@ -91,7 +92,24 @@ int runCompare(CompareArgs& args) {
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
+  const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
+  compare.methods = parseMethodList(args.methods);
+  compare.budgets = parseBudgets(args.budgets);
+  // Every scene with every pdf and then every weights; methods refused with the default
+  // pdfs or with optimal weights are left out of those cases alone, saying why.
+  auto variants = [&](const std::vector<CompareCase>& scenes) {
+    std::vector<CompareCase> cases = casesPerEnvmapPdf(scenes, pdfs);
+    if (args.command->count("--envmap-pdfs") == 0)
+      leaveOutBiasedMethods(cases, compare.methods, compare.budgets, compare.adaptive);
+    return casesPerWeights(cases, weights, compare.methods, compare.budgets, compare.adaptive);
+  };
+  // The reference's own variance, about that of a render of as many samples with the
+  // best estimator, stays within 2 % of the smallest error at the largest budget (an
+  // adaptive method may beat that estimator by 10–20 % per sample).
+  if (args.command->count("--reference-spp") == 0)
+    compare.referenceSpp = std::max(compare.referenceSpp, 64 * compare.budgets.back());
+  compare.adaptive = args.adaptive.make(compare.cases.front().scene.techniqueCount());
   std::optional<ShardRecord> shard;
   if (!args.shard.empty()) {
     // Every shard knows the whole run's cases, in order, for the merge; the merge
@@ -100,27 +118,20 @@ int runCompare(CompareArgs& args) {
     shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"});
     shard->shard = parseShard(args.shard, "--shard");
     shard->unit = unit;
-    for (const CompareCase& c : casesPerEnvmapPdf(compare.cases, pdfs)) shard->manifest.push_back(c.label);
+    for (const CompareCase& c : variants(compare.cases)) shard->manifest.push_back(c.label);
   }
   compare.cases = shardCases(compare.cases, compare.repeats, unit, shard ? shard->shard : Shard{});
-  compare.cases = casesPerEnvmapPdf(compare.cases, pdfs);
+  compare.cases = variants(compare.cases);
   for (CompareCase& c : compare.cases) c.scene.bankCacheDir = compare.cacheDir;
-  compare.methods = parseMethodList(args.methods);
-  compare.budgets = parseBudgets(args.budgets);
-  // The reference's own variance, about that of a render of as many samples with the
-  // best estimator, stays within 2 % of the smallest error at the largest budget (an
-  // adaptive method may beat that estimator by 10–20 % per sample).
-  if (args.command->count("--reference-spp") == 0)
-    compare.referenceSpp = std::max(compare.referenceSpp, 64 * compare.budgets.back());
-  compare.adaptive = args.adaptive.make(compare.cases.front().scene.techniqueCount());
-  if (args.command->count("--envmap-pdfs") == 0)
-    leaveOutBiasedMethods(compare.cases, compare.methods, compare.budgets, compare.adaptive);
   compare.device = args.devices.spec();
   validateCompareOptions(compare);
-  for (const CompareCase& c : compare.cases)
+  for (const CompareCase& c : compare.cases) {
+    AdaptiveOptions adaptive = compare.adaptive;
+    adaptive.weights = c.weights;
     for (int budget : compare.budgets)
-      requireStatisticsMemory(c.scene, compare.methods, "--budgets", budget, compare.adaptive, args.devices.onHost(),
-                              args.devices.samplerCount());
+      requireStatisticsMemory(c.scene, caseMethods(c, compare.methods), "--budgets", budget, adaptive,
+                              args.devices.onHost(), args.devices.samplerCount());
+  }
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
   std::vector<NamedFile> inputs = envmapInputs(scenes);
@@ -150,7 +161,7 @@ int runCompare(CompareArgs& args) {
                              comparison.runs.size(), outDir);
     return 130;
   }
-  std::cout << summaryMarkdown(report.summary) << report.envmapPdfTables;
+  std::cout << summaryMarkdown(report.summary) << report.envmapPdfTables << report.weightsTables;
   std::cout << fmt::format("\nwrote {}/index.html, summary.{{md,csv,json}}, budgets.csv, runs.{{json,csv}}\n", outDir);
   return 0;
 }
@@ -172,6 +183,10 @@ Subcommand addCompareCommand(CLI::App& app) {
       ->add_option("--envmap-pdfs", args->envmapPdfs,
                    "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal (default: plain and "
                    "optimal side by side; plain alone with --split-brdf)")
+      ->capture_default_str();
+  command
+      ->add_option("--weights", args->weights,
+                   "MIS weights, each scene and pdf runs with each: balance, optimal ([Kon19]; render --weights)")
       ->capture_default_str();
   command->add_option("--repeats", compare.repeats, "independent seeds per method and budget")
       ->capture_default_str()

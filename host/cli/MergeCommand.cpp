@@ -54,7 +54,7 @@ int mergeComparison(const MergeArgs& args) {
   writeRuns(staging, merged.comparison);
   ComparisonReport report = writeComparisonReport(merged.comparison, merged.options, staging);
   outputs.commit();
-  std::cout << summaryMarkdown(report.summary) << report.envmapPdfTables;
+  std::cout << summaryMarkdown(report.summary) << report.envmapPdfTables << report.weightsTables;
   std::cout << fmt::format(
       "\nmerged {} shard(s) into {}: index.html, summary.{{md,csv,json}}, budgets.csv, "
       "runs.{{json,csv}}\n",

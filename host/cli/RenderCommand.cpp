@@ -42,8 +42,8 @@ struct RenderArgs {
   int spp = 200, localSize = kDefaultLocalSize, referenceSpp = 16384;
   uint64_t seed = 1;
   bool noPreview = false;
-  std::string method = "exact", estimator = "multi", out = "render.exr", report = "render.json", reference = "auto",
-              cacheDir = defaultCacheDir(), alphaMap, shard;
+  std::string method = "exact", estimator = "multi", weights = "balance", out = "render.exr", report = "render.json",
+              reference = "auto", cacheDir = defaultCacheDir(), alphaMap, shard;
   std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
 
@@ -94,6 +94,7 @@ int runRender(RenderArgs& args) {
   args.scene.options.bankCacheDir = args.cacheDir;
   Scene scene = args.scene.make();
   AdaptiveOptions adaptive = args.adaptive.make(scene.techniqueCount());
+  adaptive.weights = parseMisWeights(args.weights, "--weights");
   requireValidRun(scene.options, m, estimator, args.spp, adaptive);
   const std::optional<Band> band = requestedBand(args, m, adaptive, scene.grid.height);
   SamplerConfig config = samplerConfigFor(m, estimator, args.spp, adaptive);
@@ -179,6 +180,11 @@ Subcommand addRenderCommand(CLI::App& app) {
   command->add_option("--alpha-map", args->alphaMap,
                       "write the per-pixel allocation: EXR here, false-colour PNG beside");
   command->add_option("--estimator", args->estimator, "fixed splits: multi ([HS14] eq. 4.1) or one (one-sample MIS)")
+      ->capture_default_str();
+  command
+      ->add_option("--weights", args->weights,
+                   "MIS weights of the multi-sample stages: balance, or optimal ([Kon19], solved per pixel from the "
+                   "stages before; equal then runs a --pilot first)")
       ->capture_default_str();
   command->add_option("--seed", args->seed, "random seed")->capture_default_str()->check(anyUnsigned64());
   args->devices.add(*command,

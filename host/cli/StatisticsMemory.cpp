@@ -39,16 +39,17 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
   }
   if (config.gridSize > 0) {
     // The weight grid, a weight per column and a cost per combination, is built on the
-    // host; the running sums, Σ g and Σ g² per column and combination, too on the C++ device
-    // where a render searches more than once (alloc/GridSearch.h). Both from the
-    // options alone: building the grid to size it would be the allocation this check
-    // prevents.
+    // host; the running sums, Σ g and Σ g² per column and combination (and with optimal
+    // weights P's C(C+1)/2 pairs), too on the C++ device where a render searches more
+    // than once (alloc/GridSearch.h). Both from the options alone: building the grid to
+    // size it would be the allocation this check prevents.
     const double U = config.gridSize, gridBytes = U * (C + 1) * sizeof(float);
-    const double sumBytes = onHost && config.runningSums ? pixels * 2 * C * U * sizeof(float) : 0;
+    const double rows = 2 * C + (config.optimalWeights ? C * (C + 1) / 2 : 0);
+    const double sumBytes = onHost && config.runningSums ? pixels * rows * U * sizeof(float) : 0;
     needs.push_back(
         {fmt::format(
              "--grid-u {} ({:g} combinations × {:g} B{})", config.gridSize, U, (C + 1) * sizeof(float),
-             sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, 2 * C * U * sizeof(float)) : ""),
+             sumBytes > 0 ? fmt::format(", and {:g} pixels × {:g} B of sums", pixels, rows * U * sizeof(float)) : ""),
          gridBytes + sumBytes});
   }
 }

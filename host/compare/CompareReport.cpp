@@ -6,6 +6,7 @@
 #include "compare/ErrorTimePlot.h"
 #include "compare/HtmlIndex.h"
 #include "compare/SummaryTables.h"
+#include "compare/WeightsComparison.h"
 
 namespace misalloc {
 
@@ -21,10 +22,12 @@ void writeCompareReport(const Summary& summary, const std::string& outDir) {
 
 ComparisonReport writeComparisonReport(const Comparison& comparison, const CompareOptions& options,
                                        const std::string& outDir) {
-  ComparisonReport report{summarize(comparison, options), ""};
+  ComparisonReport report{summarize(comparison, options), "", ""};
   writeCompareReport(report.summary, outDir);
   report.envmapPdfTables = envmapPdfMarkdown(report.summary);
   if (!report.envmapPdfTables.empty()) writeFileAtomically(outDir + "/envmap_pdfs.md", report.envmapPdfTables);
+  report.weightsTables = weightsMarkdown(report.summary);
+  if (!report.weightsTables.empty()) writeFileAtomically(outDir + "/weights.md", report.weightsTables);
   return report;
 }
 

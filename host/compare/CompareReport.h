@@ -10,12 +10,13 @@ namespace misalloc {
 void writeCompareReport(const Summary& summary, const std::string& outDir);
 
 // What a comparison writes once its runs are done: the summary (writeCompareReport)
-// and, where it compares envmap pdfs, envmap_pdfs.md; the summary and those tables are
-// returned for the console. An unsharded compare and the merge of its shards call it
-// alike.
+// and, where it compares envmap pdfs, envmap_pdfs.md, where it compares weights,
+// weights.md; the summary and those tables are returned for the console. An unsharded
+// compare and the merge of its shards call it alike.
 struct ComparisonReport {
   Summary summary;
   std::string envmapPdfTables;
+  std::string weightsTables;  // optimal against balance weights (WeightsComparison.h); empty if not both ran
 };
 ComparisonReport writeComparisonReport(const Comparison& comparison, const CompareOptions& options,
                                        const std::string& outDir);

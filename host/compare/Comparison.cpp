@@ -51,6 +51,7 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.fallbackFraction = s.fallbackFraction;
   rec.flooredFraction = s.flooredFraction;
   rec.skippedFraction = s.skippedFraction;
+  rec.weightsFallbackFraction = s.weightsFallbackFraction;
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
   rec.stages = r.stages;
   return rec;
@@ -74,6 +75,7 @@ nlohmann::json runJson(const RunRecord& r) {
           {"fallback_pixel_fraction", r.fallbackFraction},
           {"floored_pixel_fraction", r.flooredFraction},
           {"skipped_pixel_fraction", r.skippedFraction},
+          {"weights_fallback_pixel_fraction", r.weightsFallbackFraction},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
           {"stages", stagesJson(r.stages)}};
 }
@@ -89,13 +91,15 @@ std::string runsCsv(const Comparison& comparison) {
       "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,mse_corrected,"
       "mse_corrected_standard_error,relative_mse,efficiency,"
       "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,skipped_pixel_fraction,"
-      "statistics_bytes_per_pixel\n";
+      "weights_fallback_pixel_fraction,statistics_bytes_per_pixel\n";
   for (const RunRecord& r : comparison.runs)
     csv += fmt::format(
-        "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+        "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
+        "{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
         r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
-        r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.rawMse), r.mse, r.mseStandardError, r.relativeMse, r.efficiency(), r.meanAlpha.front(), r.fallbackFraction,
-        r.flooredFraction, r.skippedFraction, r.statisticsBytesPerPixel);
+        r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.rawMse), r.mse, r.mseStandardError, r.relativeMse,
+        r.efficiency(), r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.skippedFraction,
+        r.weightsFallbackFraction, r.statisticsBytesPerPixel);
   return csv;
 }
 
@@ -111,7 +115,8 @@ nlohmann::json caseInfoJson(const CaseInfo& c) {
           {"reference_variance", c.referenceVariance},
           {"device", c.device},
           {"left_out", leftOutJson(c.leftOut)},
-          {"repeats", c.repeats}};
+          {"repeats", c.repeats},
+          {"weights", misWeightsName(c.weights)}};
 }
 
 // Rewritten after every run, so that an interrupted comparison keeps what finished.
@@ -151,9 +156,12 @@ void validateCompareOptions(const CompareOptions& options) {
       throw InputError("--budgets: list each budget once, in ascending order");
   }
   if (options.repeats < 1) throw InputError(fmt::format("--repeats {}: need at least 1", options.repeats));
-  for (const CompareCase& c : options.cases)
+  for (const CompareCase& c : options.cases) {
+    AdaptiveOptions adaptive = options.adaptive;
+    adaptive.weights = c.weights;
     for (Method m : caseMethods(c, options.methods))
-      for (int budget : options.budgets) requireValidRun(c.scene, m, Estimator::MultiSample, budget, options.adaptive);
+      for (int budget : options.budgets) requireValidRun(c.scene, m, Estimator::MultiSample, budget, adaptive);
+  }
 }
 
 Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard) {
@@ -178,10 +186,11 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     const std::optional<Reference>& reference = basis.reference;
     AdaptiveOptions adaptive = options.adaptive;
     adaptive.costs = basis.costs;
+    adaptive.weights = c.weights;
     double referenceVariance = 0;
     for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
     out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name(), c.leftOut, c.repeats});
+                         reference->source, referenceVariance, devices.name(), c.leftOut, c.repeats, c.weights});
     const CaseInfo& info = out.cases.back();
     const double exposure = previewExposure(reference->image);
     writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);

@@ -21,8 +21,9 @@ struct LeftOutMethod {
 struct CompareCase {
   std::string label;
   SceneOptions scene;
-  std::vector<LeftOutMethod> leftOut;  // the default pdfs: methods biased with this case's pdf
-  std::vector<int> repeats;            // the repeats this process runs, ascending (compare/ShardUnit.h)
+  std::vector<LeftOutMethod> leftOut;        // methods biased with this case's pdf, or without its weights
+  std::vector<int> repeats;                  // the repeats this process runs, ascending (compare/ShardUnit.h)
+  MisWeights weights = MisWeights::Balance;  // of every method's multi-sample stages (--weights)
 };
 
 // The methods of `methods` that `c` runs, in that order.
@@ -60,6 +61,7 @@ struct RunRecord {
   double fallbackFraction = 0;    // pixels where an allocation rule fell back
   double flooredFraction = 0;     // pixels whose counts were raised to one per technique
   double skippedFraction = 0;     // pixels the skip rule kept at equal weights
+  double weightsFallbackFraction = 0;  // optimal weights: pixels a stage left at the balance heuristic
   double statisticsBytesPerPixel = 0;
   std::vector<StageTiming> stages;  // kernel times, predicted and measured
 
@@ -79,6 +81,7 @@ struct CaseInfo {
   std::string device;
   std::vector<LeftOutMethod> leftOut;
   std::vector<int> repeats;  // those its runs are of: a shard's, or all
+  MisWeights weights = MisWeights::Balance;
 };
 
 struct Comparison {

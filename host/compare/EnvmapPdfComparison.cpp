@@ -14,20 +14,18 @@
 namespace misalloc {
 namespace {
 
-// The scene a case renders, whatever its pdf: its scene JSON without the pdf.
+// The scene a case renders, whatever its pdf and weights: its scene JSON without the pdf.
 std::string sceneWithoutPdf(const CaseInfo& info) {
   nlohmann::json scene = info.scene;
   scene.erase("envmap_pdf");
   return scene.dump();
 }
 
-
-// Every pdf run, in the order of the first scene that ran it.
+// Every pdf and weights run, in the order of the first scene that ran it.
 std::vector<std::string> pdfNames(const Summary& s) {
   std::vector<std::string> names;
   for (const CaseSummary& c : s.cases)
-    if (std::find(names.begin(), names.end(), requestedPdf(c.info)) == names.end())
-      names.push_back(requestedPdf(c.info));
+    if (std::find(names.begin(), names.end(), caseVariant(c.info)) == names.end()) names.push_back(caseVariant(c.info));
   return names;
 }
 
@@ -42,13 +40,17 @@ bool usable(const MethodSummary* m) {
 
 std::string requestedPdf(const CaseInfo& info) { return info.scene["envmap_pdf"]["requested"]; }
 
+std::string caseVariant(const CaseInfo& info) {
+  return info.weights == MisWeights::Balance ? requestedPdf(info) : requestedPdf(info) + " + optimal weights";
+}
+
 std::vector<SceneGroup> groupByScene(const Summary& s) {
   std::vector<SceneGroup> groups;
   std::map<std::string, size_t> index;
   for (const CaseSummary& c : s.cases) {
     auto [it, inserted] = index.emplace(sceneWithoutPdf(c.info), groups.size());
     if (inserted) groups.push_back({c.info.label, {}, {}});
-    groups[it->second].byPdf[requestedPdf(c.info)] = &c;
+    groups[it->second].byPdf[caseVariant(c.info)] = &c;
     groups[it->second].cases.push_back(&c);
   }
   return groups;

@@ -24,11 +24,14 @@ void leaveOutBiasedMethods(std::vector<CompareCase>& cases, const std::vector<Me
 
 // The pdf a case asked for ("plain", "optimal", …).
 std::string requestedPdf(const CaseInfo& info);
+// The pdf and, where they are not the balance heuristic, the weights a case ran with:
+// "plain", "optimal + optimal weights", … (compare/WeightsComparison.h).
+std::string caseVariant(const CaseInfo& info);
 
-// The cases of one scene, one per pdf.
+// The cases of one scene, one per pdf and weights.
 struct SceneGroup {
   std::string label;                                // the first case's
-  std::map<std::string, const CaseSummary*> byPdf;  // by requestedPdf
+  std::map<std::string, const CaseSummary*> byPdf;  // by caseVariant
   std::vector<const CaseSummary*> cases;            // in the summary's order
 };
 

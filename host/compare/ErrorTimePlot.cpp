@@ -145,7 +145,7 @@ std::string errorTimePlotSvg(const SceneGroup& scene) {
     for (const MethodSummary& m : scene.cases[pdf]->methods) {
       if (m.budgets.empty()) continue;
       const std::string name = scene.cases.size() > 1
-                                   ? methodName(m.method) + " / " + requestedPdf(scene.cases[pdf]->info)
+                                   ? methodName(m.method) + " / " + caseVariant(scene.cases[pdf]->info)
                                    : methodName(m.method);
       svg += methodLine(m, name, methodColour(m.method), pdfDash(pdf), x, y, kTop + 10 + spacing * row++);
     }

@@ -82,8 +82,7 @@ std::string indexHtml(const Summary& s) {
     for (const CaseSummary* c : scene.cases) {
       if (scene.cases.size() > 1) out += fmt::format("<h3 id=\"{0}\">{0}</h3>\n", c->info.label);
       for (const LeftOutMethod& l : c->info.leftOut)
-        out += fmt::format("<p class=\"note\">Not run: {}, biased with this pdf ({}).</p>\n", methodName(l.method),
-                           escapeHtml(l.why));
+        out += fmt::format("<p class=\"note\">Not run: {} ({}).</p>\n", methodName(l.method), escapeHtml(l.why));
       out +=
           "<h4>Equal-time RMSE×1000</h4>\n<p class=\"note\">At equal's median render times; ~: continued past the "
           "measured times with MSE ∝ 1/t.</p>\n" +

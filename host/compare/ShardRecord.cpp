@@ -24,7 +24,7 @@ nlohmann::json runRecordJson(const RunRecord& r) {
           {"seconds", {r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds}},
           {"mse", {r.mse, r.mseStandardError, r.rawMse, r.relativeMse}},
           {"mean_alpha", r.meanAlpha},
-          {"fractions", {r.fallbackFraction, r.flooredFraction, r.skippedFraction}},
+          {"fractions", {r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.weightsFallbackFraction}},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
           {"stages", stagesJson(r.stages)}};
 }
@@ -44,6 +44,7 @@ RunRecord runRecordOf(const nlohmann::json& j) {
   r.meanAlpha = j.at("mean_alpha").get<std::vector<double>>();
   const auto& f = j.at("fractions");
   r.fallbackFraction = f.at(0), r.flooredFraction = f.at(1), r.skippedFraction = f.at(2);
+  r.weightsFallbackFraction = f.at(3);
   r.statisticsBytesPerPixel = j.at("statistics_bytes_per_pixel");
   for (const auto& s : j.at("stages")) {
     StageTiming t;
@@ -68,7 +69,8 @@ CaseInfo caseInfoOf(const nlohmann::json& j) {
           j.at("reference_variance"),
           j.at("device"),
           leftOut,
-          j.at("repeats").get<std::vector<int>>()};
+          j.at("repeats").get<std::vector<int>>(),
+          parseMisWeights(j.at("weights"), "a shard's weights")};
 }
 
 }  // namespace

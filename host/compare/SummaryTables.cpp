@@ -179,8 +179,7 @@ std::string summaryMarkdown(const Summary& s) {
         first->info.device, fmt::join(s.budgets, ", "), repeats);
     for (const CaseSummary& c : s.cases)
       for (const LeftOutMethod& l : c.info.leftOut)
-        out += fmt::format("Not run in {}: {}, biased with this pdf ({}).\n\n", c.info.label, methodName(l.method),
-                           l.why);
+        out += fmt::format("Not run in {}: {} ({}).\n\n", c.info.label, methodName(l.method), l.why);
     for (const CaseSummary& c : s.cases)
       out += fmt::format("Reference of {}: {}; its own variance is {:.2f} % of the smallest error at {} spp (aim: at "
                          "most 2 %), and is taken out of every error below.\n\n",

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ostream>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 #include "paper/MixtureOptimizer.h"
 #include "paper/MixtureVariance.h"
 #include "paper/MonteCarloStudy.h"
+#include "paper/OptimalWeightsVariance.h"
 #include "paper/PublishedValues.h"
 
 namespace misalloc {
@@ -250,6 +252,27 @@ void printComparison(const std::string& id, std::ostream& out) {
   }
 }
 
+// [Kon19]'s optimal weights against the balance heuristic at the same counts: equal ones
+// and the balance heuristic's own best (unit costs), where every count is positive.
+void printOptimalWeights(const Example1D& example, std::ostream& out) {
+  const int m = example.techniqueCount();
+  const std::vector<double> equal(m, 1.0 / m);
+  const OptimalMixture best = minimiseInefficiency(example, VarianceModel::MultiSample, std::vector<double>(m, 1.0));
+  out << fmt::format(
+      "\n  Optimal MIS weights ([Kon19]): multi-sample variance (N = 1) at the same counts:\n"
+      "  {:<36} {:>14} {:>14}   {}\n",
+      "counts alpha", "balance", "optimal", "coefficients a = A^-1 b");
+  for (const std::vector<double>& alpha : {equal, best.alpha}) {
+    if (std::any_of(alpha.begin(), alpha.end(), [](double a) { return !(a > 0); })) {
+      out << fmt::format("  {:<36} a technique without samples: no optimal weights\n", numbers(alpha));
+      continue;
+    }
+    const OptimalWeightsSolution optimal = optimalWeightsVariance(example, alpha);
+    out << fmt::format("  {:<36} {:>14} {:>14}   {}\n", numbers(alpha), variance(multiSampleVariance(example, alpha)),
+                       variance(optimal.variance), optimal.a.empty() ? "-" : numbers(optimal.a));
+  }
+}
+
 void printStudy(const Example1D& example, std::ostream& out) {
   out << fmt::format(
       "\n  Monte Carlo: {} runs of {} samples per technique (seed {}); every rule allocates from the same samples.\n"
@@ -309,6 +332,7 @@ void printPaperExample(const std::string& id, std::ostream& out) {
   Example1D example = paperExample(id);
   out << example.title() << fmt::format("\n  costs {}\n\n", numbers(example.costs()));
   printComparison(id, out);
+  printOptimalWeights(example, out);
   printStudy(example, out);
 }
 

@@ -26,8 +26,10 @@ RgbImage cropImage(const RgbImage& image, int firstRow, RowRange rows) {
 
 int poolingHaloRows(Method method, const AdaptiveOptions& options) {
   const MethodTraits& traits = methodTraits(method);
-  if (!traits.adaptive() || traits.split != Split::Staged) return 0;
-  return options.poolRadius * options.stages;
+  if (traits.split == Split::Staged) return options.poolRadius * options.stages;
+  // A fixed split with optimal weights pools its pilot's sums once (render/Render.cpp).
+  if (traits.split == Split::Fixed && options.weights == MisWeights::Optimal) return options.poolRadius;
+  return 0;
 }
 
 Band bandOf(Shard shard, int height, int haloRows) {

@@ -26,7 +26,9 @@ struct Band {
 // The rows beyond a band that its pixels' allocations read: each allocation pools the
 // statistics of the pixels within the pool radius, which after the first allocation
 // depend on their own neighbours' allocations, so the window widens by the radius
-// with every allocation; fixed splits and the oracle (by the pixel alone) read none.
+// with every allocation; the optimal weights' coefficients pool the same sums before
+// each stage after the first, a fixed split's its pilot's alone; other fixed splits and
+// the oracle (by the pixel alone) read none.
 // Those rows are rendered with the image's random numbers (Scene::firstPixel), so
 // their pilots and stages are those the neighbouring band draws.
 int poolingHaloRows(Method method, const AdaptiveOptions& options);

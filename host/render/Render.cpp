@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "Error.h"
+#include "KernelCode.h"
 #include "alloc/Apportion.h"
 #include "alloc/GridSearchAllocator.h"
 #include "alloc/PixelRuleAllocator.h"
@@ -72,6 +73,7 @@ struct Progress {
   int samplesBefore = 0;
   std::vector<unsigned char> fellBack, floored;  // per pixel: a defensive rule was used
   std::vector<unsigned char> skipped;            // per pixel: the skip rule kept equal weights in every stage
+  std::vector<unsigned char> weightsFallback;    // per pixel: OptimalWeightsFallback bits of its stages
   std::vector<StageTiming> timings;
 
   Progress(int pixels, int M)
@@ -79,7 +81,8 @@ struct Progress {
         taken(size_t(pixels) * M, 0),
         fellBack(pixels, 0),
         floored(pixels, 0),
-        skipped(pixels, 0) {}
+        skipped(pixels, 0),
+        weightsFallback(pixels, 0) {}
 };
 
 // Runs one stage with the given counts; the caller adds it to the estimate.
@@ -88,8 +91,10 @@ struct Progress {
 // model then learns from the time it took; given costs (--cost) predict no seconds:
 // only their ratios are known to mean anything.
 TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples,
-                     uint64_t seed, bool keepStatistics, CostModel* costs) {
+                     uint64_t seed, bool keepStatistics, CostModel* costs,
+                     std::vector<float> optimalCoefficients = {}) {
   TakenStage stage;
+  stage.plan.optimalCoefficients = std::move(optimalCoefficients);
   stage.plan.techniqueCount = sampler.scene().techniqueCount();
   stage.plan.stageSamples = stageSamples;
   stage.plan.samplesBefore = progress.samplesBefore;
@@ -132,6 +137,21 @@ std::vector<int32_t> stageCounts(Progress& progress, const std::vector<Allocatio
   return out;
 }
 
+// The coefficients of the optimal weights for the next stage, split by `counts`, from
+// every stage so far (alloc/OptimalWeights.h); none for the balance heuristic. The grid
+// search ranked its α by the optimal weights' variance at those counts: its weights are
+// solved at them too, from the samples the last stage (`last`) stored.
+std::vector<float> nextCoefficients(StageSampler& sampler, Progress& progress, Method method, MisWeights weights,
+                                    int poolRadius, const StagePlan& first, const StagePlan& last,
+                                    const std::vector<int32_t>& counts) {
+  if (weights != MisWeights::Optimal) return {};
+  StageCoefficients next = methodTraits(method).searchesWeights
+                               ? retargetedCoefficients(sampler, last, counts, poolRadius)
+                               : optimalCoefficients(sampler, poolRadius, first, counts);
+  for (size_t p = 0; p < next.fallback.size(); ++p) progress.weightsFallback[p] |= next.fallback[p];
+  return std::move(next.coefficients);
+}
+
 // The pilot: every pixel splits its first stage equally.
 std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
   return sameCountsEverywhere(pixels, apportionCounts(std::vector<double>(M, 1.0), stageSamples));
@@ -156,6 +176,10 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   if (config.estimator == Estimator::Resampled) config.risCandidates = options.risCandidates;
   config.statsMask = traits.statistics;
   config.sampleCapacity = traits.storesSamples ? spp : 0;
+  if (options.weights == MisWeights::Optimal) {
+    config.optimalWeights = true;
+    config.statsMask |= MA_STATS_OPTIMAL;
+  }
   if (traits.searchesWeights) {
     // The grid searches keep running sums: the samples of one stage at a time are
     // stored, and the last stage stores none (the oracle's: its probe only).
@@ -164,7 +188,9 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
     config.gridSize = options.gridSize;
     config.runningSums = traits.split == Split::Staged && options.stages > 1;
     // Rule (b) judges each α_0 by the pdf of the share it would run (WeightGrid).
-    config.shareColumns = traits.split == Split::Probed || options.gridRule == GridRule::MinCostVariance;
+    // With optimal weights the search ranks [Kon19]'s variance of the pilot's own pdfs.
+    config.shareColumns = (traits.split == Split::Probed || options.gridRule == GridRule::MinCostVariance) &&
+                          options.weights == MisWeights::Balance;
   }
   return config;
 }
@@ -211,6 +237,8 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   const MethodTraits& traits = methodTraits(method);
   const Estimator estimator = sampler.config().estimator;
   requireValidRun(scene.options, method, estimator, spp, options);
+  if ((options.weights == MisWeights::Optimal) != sampler.config().optimalWeights)
+    throw std::logic_error("the sampler's config does not match the weights asked for (samplerConfigFor)");
   std::unique_ptr<StageAllocator> allocator;
   std::optional<CostModel> givenCosts;
   CostModel* model = nullptr;
@@ -230,7 +258,24 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   sampler.reset();
   Rendering out;
   Progress progress(pixels, M);
-  if (!traits.adaptive()) {
+  if (!traits.adaptive() && options.weights == MisWeights::Optimal) {
+    // A fixed split has nothing to solve the optimal weights from: a pilot of the same
+    // split with the balance heuristic, then the rest with the weights solved from it,
+    // each stage weighted by its size.
+    std::vector<int> sizes = stageSizes(options.pilotFraction, 1, spp, M);
+    out.stageCount = 2;
+    TakenStage pilot =
+        takeStage(sampler, progress, singleStagePlan(scene, method, sizes[0]).counts, sizes[0], seed, true, nullptr);
+    accumulateStage(progress.totals, pilot, estimator, std::vector<double>(pixels, double(sizes[0]) / spp));
+    auto solveStart = Clock::now();
+    std::vector<int32_t> counts = singleStagePlan(scene, method, sizes[1]).counts;
+    std::vector<float> coefficients = nextCoefficients(sampler, progress, method, options.weights, options.poolRadius,
+                                                       pilot.plan, pilot.plan, counts);
+    out.allocationSeconds = secondsSince(solveStart);
+    TakenStage rest =
+        takeStage(sampler, progress, std::move(counts), sizes[1], seed, false, nullptr, std::move(coefficients));
+    accumulateStage(progress.totals, rest, estimator, std::vector<double>(pixels, double(sizes[1]) / spp));
+  } else if (!traits.adaptive()) {
     TakenStage stage =
         takeStage(sampler, progress, singleStagePlan(scene, method, spp).counts, spp, seed, false, nullptr);
     accumulateStage(progress.totals, stage, estimator, std::vector<double>(pixels, 1.0));
@@ -239,14 +284,18 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     // seed of its own, stands in for the true variance as a function of α; the render
     // then takes the α it finds best in one stage.
     auto probeStart = Clock::now();
-    takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples), options.oracleSamples, ~seed, true,
-              model);
+    TakenStage probe = takeStage(sampler, progress, equalCounts(pixels, M, options.oracleSamples),
+                                 options.oracleSamples, ~seed, true, model);
     std::vector<Allocation> best = allocator->allocate(sampler, model->perSample(false)).allocations;
-    out.allocationSeconds = secondsSince(probeStart);
     Progress render(pixels, M);
     render.samplesBefore = progress.samplesBefore;
     render.timings = std::move(progress.timings);
-    TakenStage stage = takeStage(sampler, render, stageCounts(render, best, spp), spp, seed, false, model);
+    std::vector<int32_t> counts = stageCounts(render, best, spp);
+    // The probe is per pixel: the oracle's weights are solved from the pixel's own.
+    std::vector<float> coefficients =
+        nextCoefficients(sampler, render, method, options.weights, 0, probe.plan, probe.plan, counts);
+    out.allocationSeconds = secondsSince(probeStart);
+    TakenStage stage = takeStage(sampler, render, std::move(counts), spp, seed, false, model, std::move(coefficients));
     accumulateStage(render.totals, stage, estimator, std::vector<double>(pixels, 1.0));
     progress = std::move(render);
   } else {
@@ -254,6 +303,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     out.stageCount = int(sizes.size());
     std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
     TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true, model);
+    StagePlan last = pilot.plan;  // the last stage, whose samples a grid search stored
     std::vector<double> pilotWeights;
     for (size_t b = 1; b < sizes.size(); ++b) {
       const bool keepStatistics = b + 1 < sizes.size();
@@ -262,13 +312,17 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
       StageAllocation next = allocator->allocate(sampler, model->perSample(keepStatistics));
       for (int p = 0; p < pixels; ++p) progress.skipped[p] &= next.skipped[p];
       std::vector<int32_t> counts = stageCounts(progress, next.allocations, sizes[b]);
+      std::vector<float> coefficients =
+          nextCoefficients(sampler, progress, method, options.weights, options.poolRadius, pilot.plan, last, counts);
       out.allocationSeconds += secondsSince(allocationStart);
       if (b == 1) {
         pilotWeights.resize(pixels);
         for (int p = 0; p < pixels; ++p) pilotWeights[p] = pilotWeight(next.varianceRatio[p], sizes[0], spp);
         accumulateStage(progress.totals, pilot, estimator, pilotWeights);
       }
-      TakenStage stage = takeStage(sampler, progress, std::move(counts), sizes[b], seed, keepStatistics, model);
+      TakenStage stage = takeStage(sampler, progress, std::move(counts), sizes[b], seed, keepStatistics, model,
+                                   std::move(coefficients));
+      last = stage.plan;
       // The stages after the pilot share the rest of the weight by their sizes.
       std::vector<double> weights(pixels);
       for (int p = 0; p < pixels; ++p) weights[p] = (1 - pilotWeights[p]) * sizes[b] / double(spp - sizes[0]);
@@ -279,6 +333,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
   out.fallbackPixels = size_t(std::count(progress.fellBack.begin(), progress.fellBack.end(), 1));
   out.flooredPixels = size_t(std::count(progress.floored.begin(), progress.floored.end(), 1));
   out.skippedPixels = size_t(std::count(progress.skipped.begin(), progress.skipped.end(), 1));
+  out.weightsFallbacks = countWeightsFallbacks(progress.weightsFallback);
   out.image = RgbImage{scene.grid.width, scene.grid.height,
                        std::vector<float>(progress.totals.rgb.begin(), progress.totals.rgb.end())};
   out.variance = std::move(progress.totals.variance);

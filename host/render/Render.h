@@ -5,7 +5,9 @@
 
 #include "alloc/GridSearch.h"
 #include "alloc/LinearAllocation.h"
+#include "alloc/OptimalWeights.h"
 #include "render/Method.h"
+#include "render/MisWeights.h"
 #include "sampling/Sampler.h"
 #include "scene/ExrIO.h"
 
@@ -33,6 +35,9 @@ struct AdaptiveOptions {
   GridRule gridRule = GridRule::MinCostVariance;
   int oracleSamples = 1024;  // oracle: equal-count probe samples per pixel
   int risCandidates = kDefaultRisCandidates;  // ris: envmap candidates per sample ([TCE05])
+  // The weights of every stage after the first: with Optimal, equal also runs a pilot
+  // (render/Render.cpp, docs/methods.md).
+  MisWeights weights = MisWeights::Balance;
 };
 
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError
@@ -54,6 +59,7 @@ struct Rendering {
   size_t fallbackPixels = 0;     // pixels where an allocation rule fell back (alloc/Allocation.h)
   size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
   size_t skippedPixels = 0;      // pixels that the skip rule kept at equal weights in every stage
+  OptimalWeightsFallbacks weightsFallbacks;  // --weights optimal: pixels a stage left at the balance heuristic
   int stageCount = 1;
   double meanPilotWeight = 0;          // staged methods: the pilot's weight in the estimate, mean over pixels
   double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
@@ -68,8 +74,9 @@ struct Rendering {
 };
 
 // Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods
-// in a pilot and `stages` batches. The sampler must keep what the method needs
-// (samplerConfigFor); whatever it took before is forgotten (StageSampler::reset).
+// in a pilot and `stages` batches. With optimal weights every stage after the first
+// uses them, a fixed split then also running a pilot of options.pilotFraction. The sampler must keep what the method
+// needs (samplerConfigFor); whatever it took before is forgotten (StageSampler::reset).
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
 
 SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);

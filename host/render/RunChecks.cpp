@@ -81,7 +81,49 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
         biasReason(pdf, traits.estimator, M), traits.split == Split::Staged ? " or lower --stages" : ""));
 }
 
+// [Kon19]'s optimal weights replace the multi-sample balance heuristic of a method's
+// stages: a single technique has no weights to choose, σ/√c allocates for its
+// count-independent weights, and the one-sample estimator has no counts n_k to weigh by.
+// Each stage must give every technique a sample: Σ_k a_k enters through technique k's
+// samples (kernels/pixel.h, withOptimalWeights).
+void requireOptimalWeightsRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,
+                              const AdaptiveOptions& options) {
+  if (options.weights != MisWeights::Optimal) return;
+  const MethodTraits& traits = methodTraits(method);
+  const int M = scene.techniqueCount();
+  if (!takesOptimalWeights(method, estimator))
+    throw InputError(fmt::format(
+        "--weights optimal with --method {}{}: [Kon19]'s optimal weights replace the multi-sample balance heuristic "
+        "of a split over every technique; {}; use --weights balance, or equal, heuristic, linear, exact or oracle",
+        traits.name, traits.adaptive() || estimator == Estimator::MultiSample ? "" : " --estimator one",
+        traits.adaptive()         ? "its stages use the count-independent weights ([SHS16] eq. 26) it allocates for"
+        : method != Method::Equal ? "one technique has no weights to choose"
+                                  : "the one-sample estimator has no counts to weigh by"));
+  if (options.poolRadius < 0)
+    throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
+  if (traits.split == Split::Staged && traits.searchesWeights && options.gridRule == GridRule::MaxEntropy)
+    throw InputError(
+        "--weights optimal with --grid-rule entropy: [HS14] eq. 4.16 ranks the balance heuristic; use --grid-rule "
+        "variance, which ranks the variance of the optimal weights");
+  std::vector<int> sizes{spp};
+  if (traits.split != Split::Probed)
+    sizes = stageSizes(options.pilotFraction, traits.adaptive() ? options.stages : 1, spp, M);
+  const int smallest = *std::min_element(sizes.begin(), sizes.end());
+  if (smallest < M)
+    throw InputError(
+        fmt::format("--spp {} with --weights optimal: a stage of {} sample(s) cannot give each of the {} "
+                    "techniques one, and the optimal weights need a sample of each in every stage; raise "
+                    "--spp{}",
+                    spp, smallest, M, traits.split == Split::Staged ? " or lower --stages" : ""));
+}
+
 }  // namespace
+
+bool takesOptimalWeights(Method method, Estimator estimator) {
+  const MethodTraits& traits = methodTraits(method);
+  return traits.adaptive() ? traits.estimator == Estimator::MultiSample
+                           : method == Method::Equal && estimator == Estimator::MultiSample;
+}
 
 bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator) {
   if (estimator == Estimator::CountIndependent) return sampled == allTechniques(techniqueCount);
@@ -116,6 +158,7 @@ void requireValidRun(const SceneOptions& scene, Method method, Estimator estimat
       throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
   }
   requireCoveredStages(scene, method, estimator, spp, options);
+  requireOptimalWeightsRun(scene, method, estimator, spp, options);
 }
 
 }  // namespace misalloc

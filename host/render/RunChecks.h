@@ -17,12 +17,19 @@ namespace misalloc {
 // ([TCE05]) draws its candidates from the envmap pdf alone, which must then cover it.
 bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator);
 
+// Whether a run of `method` with `estimator` (a fixed split's) has the multi-sample
+// balance heuristic whose weights [Kon19]'s optimal weights replace (--weights optimal):
+// the adaptive methods whose stages are multi-sample, and equal with the multi-sample
+// estimator.
+bool takesOptimalWeights(Method method, Estimator estimator);
+
 // Throws InputError, before any work, for a run of `method` on `scene` with `spp`
 // samples per pixel that the options make impossible (a schedule that does not fit the
-// budget, a probe too small, costs of the wrong count, the entropy rule with pooling) or
-// biased: any stage whose counts could leave the sampled techniques short of covering
-// the integrand. Render's floor gives every technique one sample of a stage of at
-// least M samples; a smaller allocated stage may go to any single technique.
+// budget, a probe too small, costs of the wrong count, the entropy rule with pooling,
+// optimal weights where no multi-sample balance heuristic runs) or biased: any stage
+// whose counts could leave the sampled techniques short of covering the integrand, or a
+// technique without a sample in a stage with optimal weights. Render's floor gives every technique one sample of a
+// stage of at least M samples; a smaller allocated stage may go to any single technique.
 void requireValidRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,
                      const AdaptiveOptions& options);
 

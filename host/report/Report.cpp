@@ -77,6 +77,21 @@ nlohmann::json devicesJson(const Rendering& r) {
   return list;
 }
 
+// The weights of the multi-sample stages; with [Kon19]'s optimal weights, the pixels
+// whose stages kept the balance heuristic, and why (alloc/OptimalWeights.h).
+nlohmann::json weightsJson(MisWeights weights, const Rendering& r, const RunSummary& summary) {
+  nlohmann::json json = {{"rule", misWeightsName(weights)}};
+  if (weights != MisWeights::Optimal) return json;
+  const OptimalWeightsFallbacks& f = r.weightsFallbacks;
+  json["fallback_pixels"] = f.pixels;
+  json["fallback_pixel_fraction"] = summary.weightsFallbackFraction;
+  json["fallback_reasons"] = {{"too_few_samples", f.tooFewSamples},
+                              {"ill_conditioned", f.illConditioned},
+                              {"non_finite", f.nonFinite},
+                              {"other_envmap_table", f.otherEnvmapTable}};
+  return json;
+}
+
 }  // namespace
 
 nlohmann::json sceneJson(const Scene& scene) {
@@ -140,6 +155,7 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"scene", sceneJson(run.scene)},
       {"method", methodName(run.method)},
       {"estimator", estimatorName(run.estimator)},
+      {"weights", weightsJson(run.adaptive.weights, r, summary)},
       {"spp", run.spp},
       {"seed", run.seed},
       {"device", run.device},

@@ -13,6 +13,7 @@ RunSummary summarizeRun(const Rendering& r, int techniqueCount, const Reference*
   s.fallbackFraction = double(r.fallbackPixels) / double(pixels);
   s.flooredFraction = double(r.flooredPixels) / double(pixels);
   s.skippedFraction = double(r.skippedPixels) / double(pixels);
+  s.weightsFallbackFraction = double(r.weightsFallbacks.pixels) / double(pixels);
   if (reference) {
     const double e = rmse(r.image, reference->image);
     s.mse = e * e;

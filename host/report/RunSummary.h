@@ -15,6 +15,7 @@ struct RunSummary {
   double fallbackFraction = 0;    // pixels where an allocation rule fell back
   double flooredFraction = 0;     // pixels whose counts the floor raised to one per technique
   double skippedFraction = 0;     // pixels the skip rule kept at equal weights
+  double weightsFallbackFraction = 0;  // --weights optimal: pixels a stage left at the balance heuristic
   // Against the reference, where there is one: raw, and corrected for its own variance.
   std::optional<double> mse, relativeMse;
   std::optional<CorrectedMse> corrected;

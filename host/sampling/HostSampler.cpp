@@ -28,6 +28,21 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   return env;
 }
 
+namespace {
+
+// Pixel p's coefficients of the optimal weights as kernels/sample.cl reads them: all 0
+// where the plan has none.
+kern::OptimalCoefficients optimalCoefficients(const StagePlan& plan, int pixel, int M) {
+  kern::OptimalCoefficients a{};
+  if (plan.optimalCoefficients.empty()) return a;
+  const float* row = plan.optimalCoefficients.data() + size_t(pixel) * 3 * M;
+  for (int ch = 0; ch < 3; ++ch)
+    for (int k = 0; k < M; ++k) a.a[ch][k] = row[ch * M + k];
+  return a;
+}
+
+}  // namespace
+
 HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
   share_.name = kHostSamplerName;
@@ -68,15 +83,17 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
         kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
                               config_.estimator == Estimator::OneSample,
                               config_.estimator == Estimator::CountIndependent, config_.risCandidates);
+    const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {
       kern::SampleContribution s = kern::takeStageSample(ts, pixelEnv, b, c, j, uint32_t(seed), uint32_t(seed >> 32),
                                                          uint32_t(scene_.firstPixel + pixel));
+      if (config_.optimalWeights) s = kern::withOptimalWeights(s, c, a);
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)
         if (s.technique == slot / perTechnique)
-          running[slot] += kern::statValue(int(config.statsMask), slot % perTechnique, s);
+          running[slot] += kern::statValue(int(config.statsMask), M, slot % perTechnique, s);
       if (config.sampleCapacity > 0) {
         int i = firstSlot + j;
         const int C = columns.count();

@@ -41,11 +41,12 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
       "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
-      "-DMA_SHARE_COLUMNS={} -DMA_LOCAL_SIZE={}",
+      "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_LOCAL_SIZE={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent, t.bankShares, t.blockLog2, config.estimator == Estimator::OneSample ? 1 : 0,
       config.estimator == Estimator::CountIndependent ? 1 : 0, config.risCandidates, config.statsMask,
-      config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, localSize);
+      config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0,
+      localSize);
 }
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
@@ -69,7 +70,11 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
   // Both kernels run at one size: that of the one with the running sums, the larger.
   const LaunchShape shape = chooseLocalSize(
-      deviceLimits(device.device), [&](int size) { return sampleKernelLocalBytes(size, statSlots(), doubleSums_); },
+      deviceLimits(device.device),
+      [&](int size) {
+        return sampleKernelLocalBytes(size, statSlots(), doubleSums_,
+                                      config.optimalWeights ? 3 * scene.techniqueCount() : 0);
+      },
       localSize);
   localSize_ = shape.localSize;
   share_.launch = shape.why;
@@ -98,6 +103,8 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   pixelOrder_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * sizeof(int32_t));
   rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * 3 * accSize);
   moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
+  if (config.optimalWeights)
+    coefficients_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * 3 * M * sizeof(float));
   share_.name = device.name();
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
@@ -127,11 +134,19 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
-  bindKernelArgs(kernel, b.texels, b.cdfTable, b.aliasTable, b.blockProbs, cl_int(scene_.tables.width),
-                 cl_int(scene_.tables.height), b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2],
-                 counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
-                 cl_int(scene_.firstPixel), cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
-                 cl_int(firstSlot), cl_int(config_.sampleCapacity));
+  if (config_.optimalWeights) writeCoefficients(plan, range);
+  // The optimal weights' coefficients are an argument of their kernels only.
+  auto bind = [&](const auto&... args) {
+    if (config_.optimalWeights)
+      bindKernelArgs(kernel, args..., coefficients_);
+    else
+      bindKernelArgs(kernel, args...);
+  };
+  bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
+       b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
+       cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
+       cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
+       cl_int(config_.sampleCapacity));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);
@@ -169,6 +184,14 @@ void Sampler::loadStoredSamples(const std::vector<float>& samples) {
 }
 
 std::vector<DeviceShare> Sampler::deviceShares() const { return {share_}; }
+
+void Sampler::writeCoefficients(const StagePlan& plan, PixelRange range) {
+  const size_t perPixel = size_t(3) * scene_.techniqueCount(), values = size_t(range.size()) * perPixel;
+  const std::vector<float> zeros(plan.optimalCoefficients.empty() ? values : 0, 0.0f);
+  const float* rows = zeros.empty() ? plan.optimalCoefficients.data() + size_t(range.begin) * perPixel : zeros.data();
+  device_.queue.enqueueWriteBuffer(coefficients_, CL_TRUE, size_t(range.begin) * perPixel * sizeof(float),
+                                   values * sizeof(float), rows);
+}
 
 void Sampler::forgetStages() {
   const size_t bytes = size_t(scene_.pixelCount()) * statSlots() * (doubleSums_ ? sizeof(double) : sizeof(float));

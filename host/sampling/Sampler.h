@@ -56,6 +56,10 @@ class Sampler : public StageSampler {
   void forgetStages() override;
 
  private:
+  // The plan's optimal-weight coefficients of `range` (zeros where it has none) into
+  // coefficients_.
+  void writeCoefficients(const StagePlan& plan, PixelRange range);
+
   const Device& device_;
   int localSize_;
   bool doubleSums_;
@@ -64,6 +68,7 @@ class Sampler : public StageSampler {
   cl::Buffer stats_, samples_;
   // A stage's per-pixel inputs and outputs, whole-image sized so that a tile writes its rows.
   cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
+  cl::Buffer coefficients_;  // --weights optimal: a_{c,k} per pixel (StagePlan::optimalCoefficients)
   DeviceShare share_;  // since reset()
 };
 

@@ -28,6 +28,10 @@ struct StagePlan {
   // False for a stage that no allocation follows: it runs the kernel without running
   // sums or stored samples, as fast as a fixed split's. Only the last stage may.
   bool keepStatistics = true;
+  // With optimal weights (SamplerConfig::optimalWeights), each pixel's coefficients a_{c,k}
+  // at [pixel·3M + c·M + k] (kernels/pixel.h, OptimalCoefficients); empty: all 0, the
+  // balance heuristic.
+  std::vector<float> optimalCoefficients;
 };
 
 // A stage's counts [pixel·M + k] where every pixel takes the same `counts` ([k]).
@@ -67,6 +71,8 @@ struct SamplerConfig {
   // bank, where the scene has one (SampleColumns): for the grid search's rule (b).
   bool shareColumns = false;
   int risCandidates = 0;  // the resampled estimator's candidates per sample; 0 for the others
+  // [Kon19]'s optimal weights with the stage plans' coefficients (multi-sample only).
+  bool optimalWeights = false;
 };
 
 // The columns of a stored sample (kernels/stats.h): the pdfs an allocation weighs, one

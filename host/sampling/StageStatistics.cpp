@@ -14,6 +14,8 @@ StageStatistics::StageStatistics(const Scene& scene, const SamplerConfig& config
     throw std::invalid_argument("the allocations' statistics are kept for the multi-sample estimators only");
   if ((config.estimator == Estimator::Resampled) != (config.risCandidates > 0))
     throw std::invalid_argument("resampling needs candidates, and only resampling takes them");
+  if (config.optimalWeights && config.estimator != Estimator::MultiSample)
+    throw std::invalid_argument("the optimal weights are those of the multi-sample estimator");
 }
 
 int StageStatistics::statSlots() const {

@@ -62,10 +62,13 @@ Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler, const 
 }
 
 // Every program a Sampler can build: per scene, each method's config (the fixed splits
-// with every estimator) and its plainConfig, at each work-group size, and the grid
-// search where the config asks for one (Sampler's constructor); not those of runs that
+// with every estimator) and its plainConfig, with either MIS weights where the run
+// takes them (render/RunChecks.h), at each work-group size, and the grid search where
+// the config asks for one (Sampler's constructor); not those of runs that
 // requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank (M = 2
-// only) on one map: the map changes MA_COSK alone.
+// only) on one map: the map changes MA_COSK alone. The optimal weights at the CPU's and
+// the largest GPU's work-group only: the size changes the local arrays' lengths alone,
+// and their 100 variants at the other sizes would cost CI about 7 s.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
   for (const std::string pdf : {"plain", "optimal"})
@@ -75,19 +78,26 @@ std::set<Variant> hostVariants() {
           if (pdf == "optimal" && (split || envmap != "constant")) continue;
           Scene s = scene(envmap, split, sampler, pdf);
           for (Method method : allMethods())
-            for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent}) {
-              try {
-                requireValidRun(s.options, method, estimator, 64, AdaptiveOptions{});
-              } catch (const InputError&) {
-                continue;
+            for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent})
+              for (MisWeights weights : {MisWeights::Balance, MisWeights::Optimal}) {
+                AdaptiveOptions options;
+                options.weights = weights;
+                if (weights == MisWeights::Optimal && !takesOptimalWeights(method, estimator)) continue;
+                try {
+                  requireValidRun(s.options, method, estimator, 64, options);
+                } catch (const InputError&) {
+                  continue;
+                }
+                SamplerConfig config = samplerConfigFor(method, estimator, 64, options);
+                for (int localSize : {8, 64, 128, 256}) {
+                  if (config.optimalWeights && localSize != 8 && localSize != 256) continue;
+                  variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
+                  variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
+                }
+                if (config.gridSize > 0)
+                  variants.insert(
+                      {"gridsearch.cl", gridSearchKernelOptions(sampleColumns(s, config), config.optimalWeights)});
               }
-              SamplerConfig config = samplerConfigFor(method, estimator, 64, AdaptiveOptions{});
-              for (int localSize : {8, 64, 128, 256}) {
-                variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
-                variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
-              }
-              if (config.gridSize > 0) variants.insert({"gridsearch.cl", gridSearchKernelOptions(s.techniqueCount())});
-            }
         }
   return variants;
 }
