@@ -13,6 +13,35 @@
 
 namespace misalloc {
 
+namespace {
+
+// Least squares on the relative error, (T̂ − T)/T, so that short launches weigh as much
+// as long ones, over the unknowns `free` of x = (t_0, c_0, …, c_{M−1}), none negative:
+// an unknown that comes out negative leaves the fit (t_0 first, which noise on launches
+// of few samples drives below zero) and the rest are fitted again.
+Eigen::VectorXd nonNegativeFit(const Eigen::MatrixXd& a, std::vector<int> free) {
+  const int n = int(a.rows());
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(a.cols());
+  while (!free.empty()) {
+    Eigen::MatrixXd sub(n, int(free.size()));
+    for (size_t j = 0; j < free.size(); ++j) sub.col(int(j)) = a.col(free[j]);
+    const Eigen::VectorXd solution = sub.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(n));
+    x.setZero();
+    for (size_t j = 0; j < free.size(); ++j) x(free[j]) = solution(int(j));
+    // t_0 leaves when negative, else the least c_k when it is not positive.
+    const bool interceptFree = free.front() == 0;
+    auto leaving = interceptFree && x(0) < 0 ? free.begin()
+                                             : std::min_element(free.begin() + (interceptFree ? 1 : 0), free.end(),
+                                                                [&](int i, int j) { return x(i) < x(j); });
+    if (leaving == free.end() || (*leaving != 0 && x(*leaving) > 0)) break;
+    x(*leaving) = 0;
+    free.erase(leaving);
+  }
+  return x;
+}
+
+}  // namespace
+
 CostModel CostModel::given(std::vector<double> costs) {
   CostModel model(int(costs.size()));
   for (Kernel& k : model.kernels_) k.perSample = costs;
@@ -38,10 +67,6 @@ double CostModel::predict(const LaunchWork& work) const {
   return seconds;
 }
 
-// Least squares on the relative error, (T̂ − T)/T, so that short launches weigh as much
-// as long ones. Unknowns x = (t_0, c_0, …, c_{M−1}), none negative: an unknown that
-// comes out negative leaves the fit (t_0 first, which noise on launches of few
-// samples drives below zero) and the rest are fitted again.
 void CostModel::fit(Kernel& kernel) {
   const int M = int(kernel.perSample.size()), unknowns = M + 1, n = int(kernel.seen.size());
   Eigen::MatrixXd a(n, unknowns);
@@ -50,30 +75,30 @@ void CostModel::fit(Kernel& kernel) {
     a(i, 0) = 1 / launch.seconds;
     for (int k = 0; k < M; ++k) a(i, 1 + k) = launch.slots[k] / launch.seconds;
   }
-  std::vector<int> free;
-  for (int j = n > M ? 0 : 1; j < unknowns; ++j) free.push_back(j);  // t_0 only with a launch to spare
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(unknowns);
-  while (!free.empty()) {
-    Eigen::MatrixXd sub(n, int(free.size()));
-    for (size_t j = 0; j < free.size(); ++j) sub.col(int(j)) = a.col(free[j]);
-    const Eigen::VectorXd solution = sub.colPivHouseholderQr().solve(Eigen::VectorXd::Ones(n));
-    x.setZero();
-    for (size_t j = 0; j < free.size(); ++j) x(free[j]) = solution(int(j));
-    // t_0 leaves when negative, else the least c_k when it is not positive.
-    const bool interceptFree = free.front() == 0;
-    auto leaving = interceptFree && x(0) < 0 ? free.begin()
-                                             : std::min_element(free.begin() + (interceptFree ? 1 : 0), free.end(),
-                                                                [&](int i, int j) { return x(i) < x(j); });
-    if (leaving == free.end() || (*leaving != 0 && x(*leaving) > 0)) break;
-    x(*leaving) = 0;
-    free.erase(leaving);
-  }
+  std::vector<int> costs;
+  for (int k = 0; k < M; ++k) costs.push_back(1 + k);
+  std::vector<int> free = costs;
+  if (n > M) free.insert(free.begin(), 0);  // t_0 only with a launch to spare
+  Eigen::VectorXd x = nonNegativeFit(a, free);
+  // Launches so short that t_0 explains their times, every c_k within the noise of 0
+  // (a tiny image on a fast device): the samples then take all the time, or the
+  // allocations would have no cost to weigh.
+  if ((x.tail(M).array() <= 0).all()) x = nonNegativeFit(a, costs);
   kernel.perLaunch = x(0);
   // A technique whose samples the fit cannot tell from free (its time within the
-  // noise of the others') costs what the cheapest measured one does: every cost > 0.
+  // noise of the others') costs what the cheapest measured one does; where none can be
+  // told from free, each costs the launches' mean time per sample slot. Every cost > 0.
   double cheapest = 0;
   for (int k = 0; k < M; ++k)
     if (x(1 + k) > 0 && (cheapest == 0 || x(1 + k) < cheapest)) cheapest = x(1 + k);
+  if (cheapest == 0) {
+    double seconds = 0, slots = 0;
+    for (const Launch& launch : kernel.seen) {
+      seconds += launch.seconds;
+      for (double s : launch.slots) slots += s;
+    }
+    cheapest = slots > 0 ? seconds / slots : seconds;
+  }
   for (int k = 0; k < M; ++k) kernel.perSample[k] = x(1 + k) > 0 ? x(1 + k) : cheapest;
 }
 
