@@ -143,7 +143,9 @@ TEST_CASE("every pdf the optimal weights subtract integrates to 1 over the spher
   // over the whole sphere: the Phong lobe below the horizon (f = 0 there, and its
   // samples count) and the envmap's zero texels included. Midpoint quadrature about the
   // mirror direction, with 1 − cos α = 2t⁴ so that a lobe of n = 10⁴ is resolved.
-  const int nt = smallTestSize() ? 1500 : 3000, nphi = 384;
+  // 3000 rings in both sizes: with 1500 the diffuse pdf at a view of 89°, whose horizon
+  // cuts through the rings, sums to 1 + 1.8e-5, the quadrature's error, not the pdf's.
+  const int nt = 3000, nphi = 384;
   const std::vector<double> views = {0.0, 60.0, 89.0};
   const std::vector<double> exponents = smallTestSize() ? std::vector<double>{1, 1e4} : std::vector<double>{1, 30, 1e4};
   for (double view : views)
