@@ -12,6 +12,17 @@
 #include "sampling/KernelViews.h"
 
 namespace misalloc {
+namespace {
+
+// p_α(x) = Σ_k α_k p_k(x) ([HS14] eq. 4.2), in double: kernels/estimator.h's
+// mixturePdf is the kernel's float one.
+double mixtureDensity(const double* fractions, const double* pdfs, int techniqueCount) {
+  double p = 0;
+  for (int k = 0; k < techniqueCount; ++k) p += fractions[k] * pdfs[k];
+  return p;
+}
+
+}  // namespace
 
 OptimalWeightsSystem optimalWeightsSystem(const double* slots, unsigned mask, int techniqueCount) {
   if (!(mask & MA_STATS_OPTIMAL)) throw std::logic_error("optimal weights without their running sums");
@@ -109,8 +120,7 @@ RetargetedSums::RetargetedSums(const std::vector<double>& fractions) : technique
 }
 
 void RetargetedSums::add(const double* pdfs, double luminance, double mixture) {
-  double pBeta = 0;
-  for (int k = 0; k < techniqueCount; ++k) pBeta += beta[k] * pdfs[k];
+  const double pBeta = mixtureDensity(beta, pdfs, techniqueCount);
   samples += 1;
   if (!(pBeta > 0 && mixture > 0)) return;  // no technique of either mixture reaches x: f = 0 there
   const double weight = 1 / (pBeta * mixture);
@@ -162,13 +172,12 @@ StageCoefficients retargetedCoefficients(StageStatistics& stages, const StagePla
       for (int qx = std::max(0, x - poolRadius); qx <= std::min(width - 1, x + poolRadius); ++qx) {
         const int q = qy * width + qx;
         if (envmapTableOf(scene, &stored.counts[size_t(q) * M]) != table) continue;
+        double drawnFractions[kMaxTechniques];
+        for (int k = 0; k < M; ++k) drawnFractions[k] = double(stored.counts[size_t(q) * M + k]) / stored.stageSamples;
         for (int i = 0; i < stored.stageSamples; ++i) {
-          double mixture = 0;
-          for (int k = 0; k < M; ++k) {
-            pdfs[k] = samples[kern::storedSampleIndex(q, i, 2 + k, capacity, M)];
-            mixture += double(stored.counts[size_t(q) * M + k]) / stored.stageSamples * pdfs[k];
-          }
-          sums.add(pdfs, samples[kern::storedSampleIndex(q, i, 1, capacity, M)], mixture);
+          for (int k = 0; k < M; ++k) pdfs[k] = samples[kern::storedSampleIndex(q, i, 2 + k, capacity, M)];
+          sums.add(pdfs, samples[kern::storedSampleIndex(q, i, 1, capacity, M)],
+                   mixtureDensity(drawnFractions, pdfs, M));
         }
       }
     const OptimalWeightsSystem drawn =
