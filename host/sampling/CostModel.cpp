@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "Error.h"
 #include "NumberList.h"
@@ -82,23 +83,16 @@ void CostModel::fit(Kernel& kernel) {
   Eigen::VectorXd x = nonNegativeFit(a, free);
   // Launches so short that t_0 explains their times, every c_k within the noise of 0
   // (a tiny image on a fast device): the samples then take all the time, or the
-  // allocations would have no cost to weigh.
+  // allocations would have no cost to weigh. Without t_0 some c_k > 0 wherever a launch
+  // had samples.
   if ((x.tail(M).array() <= 0).all()) x = nonNegativeFit(a, costs);
   kernel.perLaunch = x(0);
   // A technique whose samples the fit cannot tell from free (its time within the
-  // noise of the others') costs what the cheapest measured one does; where none can be
-  // told from free, each costs the launches' mean time per sample slot. Every cost > 0.
+  // noise of the others') costs what the cheapest measured one does: every cost > 0.
   double cheapest = 0;
   for (int k = 0; k < M; ++k)
     if (x(1 + k) > 0 && (cheapest == 0 || x(1 + k) < cheapest)) cheapest = x(1 + k);
-  if (cheapest == 0) {
-    double seconds = 0, slots = 0;
-    for (const Launch& launch : kernel.seen) {
-      seconds += launch.seconds;
-      for (double s : launch.slots) slots += s;
-    }
-    cheapest = slots > 0 ? seconds / slots : seconds;
-  }
+  if (cheapest == 0) throw std::logic_error("cost model: no launch it was fitted on took a sample");
   for (int k = 0; k < M; ++k) kernel.perSample[k] = x(1 + k) > 0 ? x(1 + k) : cheapest;
 }
 
