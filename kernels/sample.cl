@@ -126,7 +126,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
     float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
     uint seedLo, uint seedHi, int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
-    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity
+    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity, int spareSamples
 #if MA_OPTIMAL_WEIGHTS
     ,
     __global const float* coefficients  // [pixel·3M + c·M + k]: a_{c,k} (kernels/pixel.h)
@@ -199,15 +199,15 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
         running[s][lid] +=
             counted && c.technique == s / perTechnique ? statValue(MA_STATS, MA_TECHNIQUES, s % perTechnique, c) : 0;
       }
-      if (MA_STORE_SAMPLES && counted && gid < pixelCount) {
-        int i = firstSlot + j;
-        samples[storedSampleIndex(pixel, i, 0, sampleCapacity, SAMPLE_COLUMNS)] =
-            (float)storedColumn(c, MA_SHARE_COLUMNS);
-        samples[storedSampleIndex(pixel, i, 1, sampleCapacity, SAMPLE_COLUMNS)] = c.y;
+      if (MA_STORE_SAMPLES) {
+        int kept = counted && gid < pixelCount, i = firstSlot + j;
+#define STORED_AT(q) \
+  (kept ? storedSampleIndex(pixel, i, (q), sampleCapacity, SAMPLE_COLUMNS) : spareSampleIndex(spareSamples, (q), lid))
+        samples[STORED_AT(0)] = (float)storedColumn(c, MA_SHARE_COLUMNS);
+        samples[STORED_AT(1)] = c.y;
         MA_UNROLL
-        for (int l = 0; l < SAMPLE_COLUMNS; ++l)
-          samples[storedSampleIndex(pixel, i, 2 + l, sampleCapacity, SAMPLE_COLUMNS)] =
-              storedPdf(c, MA_SHARE_COLUMNS, l);
+        for (int l = 0; l < SAMPLE_COLUMNS; ++l) samples[STORED_AT(2 + l)] = storedPdf(c, MA_SHARE_COLUMNS, l);
+#undef STORED_AT
       }
       barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
     }

@@ -89,6 +89,12 @@ MA_FN int storedSampleIndex(int pixel, int i, int q, int capacity, int columns) 
   return (((pixel / 16) * capacity + i) * MA_SAMPLE_RECORD_FLOATS(columns) + q) * 16 + pixel % 16;
 }
 
+// Where a lane stores a sample that is not kept (a surplus sample of its work-group's
+// pass, a padding work-item): a spare record after the buffer's blocks, from float
+// `spare` on. Every lane then stores, and the store needs no mask: a masked scatter,
+// which AVX2 lacks, keeps PoCL from vectorising the loop around it (docs/pocl.md).
+MA_FN int spareSampleIndex(int spare, int q, int lane) { return spare + q * 16 + lane % 16; }
+
 // The technique whose pdf column l holds.
 MA_FN int techniqueOfColumn(int l, int shareColumns) {
   return shareColumns > 0 ? (l < shareColumns ? 0 : l - shareColumns + 1) : l;

@@ -33,6 +33,13 @@ void writeSums(const Device& d, const cl::Buffer& buffer, const std::vector<doub
   d.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, raw.size() * sizeof(Acc), raw.data());
 }
 
+// The stored samples followed by the spare record that the kernel's lanes store a
+// sample they do not keep into (kernels/stats.h, spareSampleIndex).
+std::vector<float> withSpareRecord(std::vector<float> samples, const Scene& scene, const SamplerConfig& config) {
+  samples.resize(samples.size() + size_t(MA_SAMPLE_RECORD_FLOATS(sampleColumns(scene, config).count())) * 16, 0.0f);
+  return samples;
+}
+
 }  // namespace
 
 std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize) {
@@ -94,9 +101,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const size_t slots = std::max<size_t>(1, size_t(scene.pixelCount()) * statSlots());
   stats_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, slots * accSize);
   device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
-  samples_ = config.sampleCapacity > 0
-                 ? upload(device, emptyStoredSamples(scene, config), CL_MEM_READ_WRITE)
-                 : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  samples_ = config.sampleCapacity > 0 ? upload(device, withSpareRecord(emptyStoredSamples(scene, config), scene, config),
+                                                CL_MEM_READ_WRITE)
+                                       : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
   const size_t pixels = size_t(scene.pixelCount()), M = size_t(scene.techniqueCount());
   counts_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(int32_t));
   firstIndex_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(uint32_t));
@@ -146,7 +153,7 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
        b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
        cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
        cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
-       cl_int(config_.sampleCapacity));
+       cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);
