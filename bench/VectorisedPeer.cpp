@@ -80,8 +80,8 @@ TechniqueSums techniquePass(PixelPass p) {
   for (int j = 0; j < n; ++j) {
     SampleTerm s;
     if constexpr (Technique == 0) {
-      const kern::SampleContribution c = kern::takeTechniqueSample(p.ts, p.env, p.brdf, p.counts, 0, first + uint32_t(j),
-                                                                   p.seedLo, p.seedHi, p.pixelKey);
+      const kern::SampleContribution c = kern::takeTechniqueSample(p.ts, p.env, p.brdf, p.counts, 0,
+                                                                   first + uint32_t(j), p.seedLo, p.seedHi, p.pixelKey);
       s = {c.r, c.g, c.b, c.w};
     } else {
       s = brdfTerm(p, first + uint32_t(j));
@@ -143,8 +143,9 @@ StageResult VectorisedPeer::run(const StagePlan& plan, uint64_t seed) const {
   StageResult result;
   result.rgb.assign(size_t(pixels) * 3, 0.0);
   result.moments.assign(size_t(pixels) * 4, 0.0);
-  const PixelPasses passes =
-      scene_.tables.useCdf ? cdfPasses(std::max(scene_.tables.cdfStepsRow, scene_.tables.cdfStepsCol)) : &pixelPasses<0>;
+  const PixelPasses passes = scene_.tables.useCdf
+                                 ? cdfPasses(std::max(scene_.tables.cdfStepsRow, scene_.tables.cdfStepsCol))
+                                 : &pixelPasses<0>;
 #pragma omp parallel for schedule(dynamic, 64)
   for (int pixel = 0; pixel < pixels; ++pixel) {
     PixelPass p = shared;

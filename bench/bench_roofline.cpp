@@ -163,8 +163,8 @@ int main(int argc, char** argv) {
   std::vector<uint32_t> texels(tables.texels.size());
   std::memcpy(texels.data(), tables.texels.data(), 4 * texels.size());
   const double mib = 1.0 / (1 << 20);
-  fmt::print("{} threads, envmap {}, {}x{} texels\n\n| what | table | rate |\n|---|---|---|\n",
-             omp_get_max_threads(), options.envmap, tables.width, tables.height);
+  fmt::print("{} threads, envmap {}, {}x{} texels\n\n| what | table | rate |\n|---|---|---|\n", omp_get_max_threads(),
+             options.envmap, tables.width, tables.height);
   const double aliasRate = rate([&](int64_t n) { return randomReads<2>(alias, n); }, kStreams, repeats);
   fmt::print("| random reads of an alias bucket (2 words) | {:.1f} MiB | {:.3g} G/s |\n", alias.size() * 4 * mib,
              aliasRate * 1e-9);

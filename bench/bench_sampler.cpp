@@ -116,8 +116,10 @@ void checkAgainstReference(const Variant& v, const Scene& scene, const bench::Ve
                                      largestRelativeDifference(expected.moments, got.moments));
   if (expected.rgb.size() != got.rgb.size() || expected.moments.size() != got.moments.size() ||
       difference > kPeerAgreement) {
-    fmt::print(stderr, "misalloc_bench: the vectorised peer's stage of {} differs from HostSampler's by {:.3g} (at most {:g})\n",
-               v.name, difference, kPeerAgreement);
+    fmt::print(
+        stderr,
+        "misalloc_bench: the vectorised peer's stage of {} differs from HostSampler's by {:.3g} (at most {:g})\n",
+        v.name, difference, kPeerAgreement);
     std::exit(1);
   }
   fmt::print("the vectorised peer's stage of {} is HostSampler's within {:.3g} relative\n", v.name, difference);
