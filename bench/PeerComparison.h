@@ -6,11 +6,13 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,10 +36,15 @@ class MedianCollector : public benchmark::ConsoleReporter {
   std::string counter_;
 };
 
-// Registers "opencl/NAME" and "openmp/NAME": 5 repetitions of at least 0.5 s, medians.
+// Registers "opencl/NAME" and "openmp/NAME", and "openmp-simd/NAME" where a vectorised
+// peer is given: 5 repetitions of at least 0.5 s, medians.
 inline void registerPeers(const std::string& name, std::function<void(benchmark::State&)> openCl,
-                          std::function<void(benchmark::State&)> openMp) {
-  for (auto& [impl, fn] : {std::pair{"opencl", openCl}, std::pair{"openmp", openMp}})
+                          std::function<void(benchmark::State&)> openMp,
+                          std::function<void(benchmark::State&)> openMpSimd = {}) {
+  std::vector<std::pair<const char*, std::function<void(benchmark::State&)>>> impls{{"opencl", openCl},
+                                                                                    {"openmp", openMp}};
+  if (openMpSimd) impls.emplace_back("openmp-simd", openMpSimd);
+  for (auto& [impl, fn] : impls)
     benchmark::RegisterBenchmark(fmt::format("{}/{}", impl, name).c_str(), fn)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime()
@@ -83,11 +90,13 @@ inline void initialize(std::vector<char*> args) {
 
 // One closing table: a row per name with both peers' medians in `unitName`, and their
 // ratio OpenCL / OpenMP (above 1: OpenCL has the larger value, which for a time is the
-// slower). `ratios` false for rows whose ratio means nothing, such as fitted slopes.
+// slower); where a vectorised peer ran too, its median and OpenCL's ratio to it.
+// `ratios` false for rows whose ratio means nothing, such as fitted slopes.
 struct PeerTable {
   struct Row {
     std::string name;
     double openCl = 0, openMp = 0;
+    std::optional<double> openMpSimd;  // "openmp-simd/NAME"
   };
   std::string title;        // what was measured, the sizes and the device
   std::string firstColumn;  // what the row names are
@@ -97,14 +106,22 @@ struct PeerTable {
   std::vector<Row> rows;
 
   // Appends a row for every name both peers have a median of, the counter's values
-  // divided by `unit` (the counter's value of one `unitName`).
+  // divided by `unit` (the counter's value of one `unitName`), with the vectorised
+  // peer's where it has one.
   PeerTable& addMedians(const MedianCollector& collector, const std::vector<std::string>& names, double unit) {
+    const auto& medians = collector.medians;
     for (const auto& name : names) {
-      auto cl = collector.medians.find("opencl/" + name), mp = collector.medians.find("openmp/" + name);
-      if (cl != collector.medians.end() && mp != collector.medians.end())
-        rows.push_back({name, cl->second / unit, mp->second / unit});
+      auto cl = medians.find("opencl/" + name), mp = medians.find("openmp/" + name);
+      if (cl == medians.end() || mp == medians.end()) continue;
+      rows.push_back({name, cl->second / unit, mp->second / unit});
+      if (auto simd = medians.find("openmp-simd/" + name); simd != medians.end())
+        rows.back().openMpSimd = simd->second / unit;
     }
     return *this;
+  }
+
+  bool hasSimdPeer() const {
+    return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.openMpSimd.has_value(); });
   }
 
   // Three significant digits, without an exponent for large values.
@@ -113,11 +130,25 @@ struct PeerTable {
   }
 
   std::string markdown() const {
-    std::string table = fmt::format("{}\n\n| {} | OpenCL {} | OpenMP {} |{}\n|---|---|---|{}\n", title, firstColumn,
-                                    unitName, unitName, ratios ? " ratio |" : "", ratios ? "---|" : "");
-    for (const Row& r : rows)
-      table += fmt::format("| {} | {} | {} |{}\n", r.name, formatValue(r.openCl), formatValue(r.openMp),
-                           ratios ? fmt::format(" {:.2f} |", r.openCl / r.openMp) : "");
+    const bool simd = hasSimdPeer();
+    std::string table = fmt::format("{}\n\n| {} | OpenCL {} | OpenMP {} |", title, firstColumn, unitName, unitName);
+    std::string rule = "|---|---|---|";
+    if (simd) {
+      table += fmt::format(" OpenMP simd {} |", unitName);
+      rule += "---|";
+    }
+    if (ratios) {
+      table += simd ? " ratio | ratio to simd |" : " ratio |";
+      rule += simd ? "---|---|" : "---|";
+    }
+    table += "\n" + rule + "\n";
+    for (const Row& r : rows) {
+      table += fmt::format("| {} | {} | {} |", r.name, formatValue(r.openCl), formatValue(r.openMp));
+      if (simd) table += fmt::format(" {} |", r.openMpSimd ? formatValue(*r.openMpSimd) : "—");
+      if (ratios) table += fmt::format(" {:.2f} |", r.openCl / r.openMp);
+      if (ratios && simd) table += r.openMpSimd ? fmt::format(" {:.2f} |", r.openCl / *r.openMpSimd) : " — |";
+      table += "\n";
+    }
     return table;
   }
 
@@ -126,6 +157,10 @@ struct PeerTable {
     for (const Row& r : rows) {
       nlohmann::json row = {{"name", r.name}, {"opencl", r.openCl}, {"openmp", r.openMp}, {"unit", unitName}};
       if (ratios) row["ratio"] = r.openCl / r.openMp;  // OpenCL / OpenMP
+      if (r.openMpSimd) {
+        row["openmp_simd"] = *r.openMpSimd;
+        if (ratios) row["ratio_simd"] = r.openCl / *r.openMpSimd;  // OpenCL / OpenMP simd
+      }
       out["rows"].push_back(row);
     }
     return out;
@@ -138,8 +173,8 @@ inline void writeSummary(const nlohmann::json& tables) {
 }
 
 // Prints the tables in Markdown, writes them to the summary
-// ({"tables": [{title, config, rows: [{name, opencl, openmp, unit, ratio}]}]}) and
-// shuts Google Benchmark down.
+// ({"tables": [{title, config, rows: [{name, opencl, openmp, unit, ratio}]}]}, and
+// openmp_simd, ratio_simd in rows with a vectorised peer) and shuts Google Benchmark down.
 inline void finish(const std::vector<PeerTable>& tables) {
   nlohmann::json summary = nlohmann::json::array();
   for (const PeerTable& t : tables) {

@@ -1,10 +1,15 @@
 // The bounds a sampling kernel cannot pass on this CPU: how many random reads per second
-// its cores make into tables of the envmap tables' sizes, alone and as the alias
-// sampler's dependent pair (bucket, then the texel drawn), and how many fp32 fused
+// its cores make into an envmap's own tables (the kernels' buffers), alone and as the
+// alias sampler's dependent pair (bucket, then the texel drawn), and how many fp32 fused
 // multiply-adds per second they compute. docs/results.md ("Roofline") divides each
 // kernel's measured rate by these.
 //
-//   build/bench/misalloc_bench_roofline [--width 1024] [--height 512] [--repeats 5]
+//   build/bench/misalloc_bench_roofline [--envmap forest_slope] [--procedural-width 512]
+//                                       [--repeats 5]
+//
+// The pair reads the texel the map's alias table draws: where the map is bright, most
+// buckets alias to a few texels, which stay in cache, as in the kernel. The texel reads
+// alone are uniform over the map: the worst case of BRDF-sampled directions.
 //
 // Every thread of OpenMP runs 16 independent streams of reads, so that the rate is the
 // memory system's throughput, not one read's latency. Indices come from a xorshift per
@@ -20,6 +25,8 @@
 #include <cstring>
 #include <functional>
 #include <vector>
+
+#include "scene/Scene.h"
 
 namespace {
 
@@ -102,24 +109,40 @@ float aliasPairs(const std::vector<uint32_t>& alias, const std::vector<uint32_t>
   });
 }
 
-// 16 independent chains of 16-lane fp32 fmas, held in registers (unrolled), fused
-// (-ffp-contract=fast, bench/CMakeLists.txt): enough to fill the FMA pipes.
+// The widest vector of fp32 lanes this CPU computes in.
+#if defined(__AVX512F__)
+constexpr int kLanes = 16;
+#elif defined(__AVX__)
+constexpr int kLanes = 8;
+#else
+constexpr int kLanes = 4;
+#endif
+
+// Independent fma chains: an fma's latency (4 cycles on Zen and Skylake) times the 2
+// pipes that issue them, plus spares against the loop's own instructions, all held in
+// registers: 12 chains, a and b take 14 of AVX2's 16 vector registers. Wider vectors
+// than the registers, or more chains than they hold, spill to the stack, and the loop
+// then measures stores and loads.
+constexpr int kChains = 12;
+
+// kChains chains of kLanes-lane fp32 fmas, unrolled, fused (-ffp-contract=fast,
+// bench/CMakeLists.txt): enough to fill the FMA pipes.
 float fmaChains(int64_t steps) {
-  typedef float Lanes __attribute__((vector_size(64)));
-  Lanes acc[16];
-  for (int c = 0; c < 16; ++c)
-    for (int l = 0; l < 16; ++l) acc[c][l] = float(c + l) * 1e-3f;
+  typedef float Lanes __attribute__((vector_size(4 * kLanes)));
+  Lanes acc[kChains];
+  for (int c = 0; c < kChains; ++c)
+    for (int l = 0; l < kLanes; ++l) acc[c][l] = float(c + l) * 1e-3f;
   Lanes a, b;
-  for (int l = 0; l < 16; ++l) {
+  for (int l = 0; l < kLanes; ++l) {
     a[l] = 0.999f;
     b[l] = 1e-4f;
   }
   for (int64_t i = 0; i < steps; ++i)
 #pragma GCC unroll 16
-    for (int c = 0; c < 16; ++c) acc[c] = acc[c] * a + b;
+    for (int c = 0; c < kChains; ++c) acc[c] = acc[c] * a + b;
   float total = 0;
-  for (int c = 0; c < 16; ++c)
-    for (int l = 0; l < 16; ++l) total += acc[c][l];
+  for (int c = 0; c < kChains; ++c)
+    for (int l = 0; l < kLanes; ++l) total += acc[c][l];
   return total;
 }
 
@@ -127,23 +150,21 @@ float fmaChains(int64_t steps) {
 
 int main(int argc, char** argv) {
   CLI::App app{"misalloc: this CPU's random-read and fma rates, the bounds of the sampling kernels"};
-  int width = 1024, height = 512, repeats = 5;
-  app.add_option("--width", width, "envmap width (forest_slope: 1024)");
-  app.add_option("--height", height, "envmap height (forest_slope: 512)");
+  misalloc::SceneOptions options;
+  options.width = options.height = 1;  // the map's tables only
+  int repeats = 5;
+  app.add_option("--envmap", options.envmap, "the map whose alias table and texels are read");
+  app.add_option("--procedural-width", options.proceduralWidth);
   app.add_option("--repeats", repeats);
   CLI11_PARSE(app, argc, argv);
 
-  const size_t texelCount = size_t(width) * size_t(height);
-  std::vector<uint32_t> alias(2 * texelCount), texels(4 * texelCount);
-  for (size_t i = 0; i < texelCount; ++i) {
-    const float accept = float(i % 1000) / 1000.0f;
-    std::memcpy(&alias[2 * i], &accept, 4);
-    alias[2 * i + 1] = uint32_t((i * 2654435761u) % texelCount);
-    for (int w = 0; w < 4; ++w) texels[4 * i + w] = uint32_t(i + w);
-  }
+  const misalloc::EnvmapTables tables = misalloc::makeScene(options).tables;
+  const std::vector<uint32_t>& alias = tables.aliasTable;
+  std::vector<uint32_t> texels(tables.texels.size());
+  std::memcpy(texels.data(), tables.texels.data(), 4 * texels.size());
   const double mib = 1.0 / (1 << 20);
-  fmt::print("{} threads, a {}x{} map\n\n| what | table | rate |\n|---|---|---|\n", omp_get_max_threads(), width,
-             height);
+  fmt::print("{} threads, envmap {}, {}x{} texels\n\n| what | table | rate |\n|---|---|---|\n", omp_get_max_threads(),
+             options.envmap, tables.width, tables.height);
   const double aliasRate = rate([&](int64_t n) { return randomReads<2>(alias, n); }, kStreams, repeats);
   fmt::print("| random reads of an alias bucket (2 words) | {:.1f} MiB | {:.3g} G/s |\n", alias.size() * 4 * mib,
              aliasRate * 1e-9);
@@ -153,7 +174,7 @@ int main(int argc, char** argv) {
   const double pairRate = rate([&](int64_t n) { return aliasPairs(alias, texels, n); }, kStreams, repeats);
   fmt::print("| alias bucket, then the texel drawn | {:.1f} + {:.1f} MiB | {:.3g} G/s |\n", alias.size() * 4 * mib,
              texels.size() * 4 * mib, pairRate * 1e-9);
-  const double fmaRate = rate(fmaChains, 16 * 16, repeats);
-  fmt::print("| fp32 fma (16 chains of 16 lanes) | — | {:.3g} G/s = {:.0f} GFLOP/s |\n", fmaRate * 1e-9,
-             2 * fmaRate * 1e-9);
+  const double fmaRate = rate(fmaChains, kChains * kLanes, repeats);
+  fmt::print("| fp32 fma ({} chains of {} lanes) | — | {:.3g} G/s = {:.0f} GFLOP/s |\n", kChains, kLanes,
+             fmaRate * 1e-9, 2 * fmaRate * 1e-9);
 }

@@ -1,6 +1,10 @@
 // Samples per second of each technique and of the MIS estimator: kernels/sample.cl on
-// an OpenCL device (PoCL by default) side by side, in one run, with its OpenMP C++
-// peer (HostSampler: the same estimator compiled by g++ -O3 -march=native).
+// an OpenCL device (PoCL by default) side by side, in one run, with two OpenMP C++
+// peers: HostSampler, its scalar reference, and VectorisedPeer, each technique's
+// samples in an `omp simd` loop (bench/CMakeLists.txt has both's flags). The vectorised
+// peer runs the balance heuristic of the plain pdf: not RIS, whose resampling loop over
+// candidates would be a peer of its own. Before it is timed, its stage is checked against
+// HostSampler's, and the run stops where they differ.
 //
 //   build/bench/misalloc_bench [--device cpu] [--size 256] [--spp 64] [--summary FILE.json]
 //                              [--envmap forest_slope] [--procedural-width 512]
@@ -10,13 +14,19 @@
 // every table in L1: the kernels' rate without the cost of their table reads, the
 // arithmetic side of docs/results.md's roofline.
 //
-// Ends with a Markdown table of medians and the OpenCL/OpenMP ratio.
+// Ends with a Markdown table of medians and the OpenCL/OpenMP ratios.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <set>
 
 #include "PeerComparison.h"
+#include "VectorisedPeer.h"
 #include "cl/Device.h"
 #include "render/Method.h"
 #include "render/Render.h"
@@ -37,16 +47,22 @@ struct Variant {
   std::string name;
   Method method;
   EnvmapSampler sampler;
+  bool vectorisedPeer;  // VectorisedPeer runs its estimator
 };
 
 const Variant kVariants[] = {
-    {"envmap (alias)", Method::Envmap, EnvmapSampler::Alias},
-    {"envmap (cdf)", Method::Envmap, EnvmapSampler::Cdf},
-    {"brdf", Method::Brdf, EnvmapSampler::Alias},
-    {"MIS equal (alias)", Method::Equal, EnvmapSampler::Alias},
-    {"MIS equal (cdf)", Method::Equal, EnvmapSampler::Cdf},
-    {fmt::format("ris, {} candidates (alias)", kDefaultRisCandidates), Method::Ris, EnvmapSampler::Alias},
+    {"envmap (alias)", Method::Envmap, EnvmapSampler::Alias, true},
+    {"envmap (cdf)", Method::Envmap, EnvmapSampler::Cdf, true},
+    {"brdf", Method::Brdf, EnvmapSampler::Alias, true},
+    {"MIS equal (alias)", Method::Equal, EnvmapSampler::Alias, true},
+    {"MIS equal (cdf)", Method::Equal, EnvmapSampler::Cdf, true},
+    {fmt::format("ris, {} candidates (alias)", kDefaultRisCandidates), Method::Ris, EnvmapSampler::Alias, false},
 };
+
+// The vectorised peer sums HostSampler's samples in another order. Every term is ≥ 0,
+// so sums of N terms then differ by at most about N·2⁻⁵³ relative (1e-14 at 64 spp); a
+// single sample one float ulp off would show at 1e-9 or more.
+constexpr double kPeerAgreement = 1e-12;
 
 Scene benchScene(EnvmapSampler sampler) {
   SceneOptions o;
@@ -67,12 +83,51 @@ const Device& device() {
   return d;
 }
 
-void runStages(benchmark::State& state, StageSampler& sampler, const StagePlan& plan) {
-  sampler.run(plan, 1);  // warm-up: JIT and first-launch costs are not samples
+// Times `run(seed)`, a stage of `plan` with a new seed each time.
+template <typename RunStage>
+void timeStages(benchmark::State& state, const StagePlan& plan, RunStage run) {
+  run(1);  // warm-up: JIT and first-launch costs are not samples
   uint64_t seed = 2;
-  for (auto _ : state) benchmark::DoNotOptimize(sampler.run(plan, seed++).rgb.data());
+  for (auto _ : state) benchmark::DoNotOptimize(run(seed++).rgb.data());
   state.counters["samples/s"] = benchmark::Counter(double(plan.counts.size() / plan.techniqueCount) * plan.stageSamples,
                                                    benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void runStages(benchmark::State& state, StageSampler& sampler, const StagePlan& plan) {
+  timeStages(state, plan, [&](uint64_t seed) { return sampler.run(plan, seed); });
+}
+
+// Of two vectors of one size; NaN where a value is NaN on one side only, which no bound
+// accepts.
+double largestRelativeDifference(const std::vector<double>& a, const std::vector<double>& b) {
+  double largest = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i] == b[i]) continue;
+    const double difference = std::abs(a[i] - b[i]) / std::max(std::abs(a[i]), std::abs(b[i]));
+    if (std::isnan(difference)) return difference;
+    largest = std::max(largest, difference);
+  }
+  return largest;
+}
+
+// Stops the run unless the peer's estimates and moments are HostSampler's, within
+// kPeerAgreement per pixel: a faster peer that computes something else compares nothing.
+void checkAgainstReference(const Variant& v, const Scene& scene, const bench::VectorisedPeer& peer,
+                           const StagePlan& plan) {
+  HostSampler reference(scene, configOf(v));
+  const StageResult expected = reference.run(plan, 1), got = peer.run(plan, 1);
+  const bool sameSizes = expected.rgb.size() == got.rgb.size() && expected.moments.size() == got.moments.size();
+  const double estimates = sameSizes ? largestRelativeDifference(expected.rgb, got.rgb) : NAN;
+  const double moments = sameSizes ? largestRelativeDifference(expected.moments, got.moments) : NAN;
+  if (!(estimates <= kPeerAgreement && moments <= kPeerAgreement)) {
+    fmt::print(stderr,
+               "misalloc_bench: the vectorised peer's stage of {} differs from HostSampler's: estimates by {:.3g}, "
+               "moments by {:.3g} relative (at most {:g})\n",
+               v.name, estimates, moments, kPeerAgreement);
+    std::exit(1);
+  }
+  fmt::print("the vectorised peer's stage of {} is HostSampler's within {:.3g} relative\n", v.name,
+             std::max(estimates, moments));
 }
 
 void benchOpenCl(benchmark::State& state, const Variant& v) {
@@ -85,6 +140,15 @@ void benchOpenMp(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
   HostSampler sampler(scene, configOf(v));
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
+}
+
+void benchOpenMpSimd(benchmark::State& state, const Variant& v) {
+  Scene scene = benchScene(v.sampler);
+  const StagePlan plan = singleStagePlan(scene, v.method, config.spp);
+  const bench::VectorisedPeer peer(scene);
+  static std::set<std::string> checked;  // once per variant, not per repetition
+  if (checked.insert(v.name).second) checkAgainstReference(v, scene, peer, plan);
+  timeStages(state, plan, [&](uint64_t seed) { return peer.run(plan, seed); });
 }
 
 }  // namespace
@@ -101,8 +165,11 @@ int main(int argc, char** argv) {
   std::vector<std::string> names;
   for (const Variant& v : kVariants) {
     names.push_back(v.name);
+    std::function<void(benchmark::State&)> simd;
+    if (v.vectorisedPeer) simd = [&v](benchmark::State& s) { benchOpenMpSimd(s, v); };
     bench::registerPeers(
-        v.name, [&v](benchmark::State& s) { benchOpenCl(s, v); }, [&v](benchmark::State& s) { benchOpenMp(s, v); });
+        v.name, [&v](benchmark::State& s) { benchOpenCl(s, v); }, [&v](benchmark::State& s) { benchOpenMp(s, v); },
+        simd);
   }
   bench::MedianCollector reporter("samples/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
