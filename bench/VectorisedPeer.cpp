@@ -41,8 +41,8 @@ struct SampleTerm {
 // lobe: sampleBrdf picks it with a branch around both lobes' inlined code, and g++ 12
 // does not if-convert a block with an internal call in it (sinCos2Pi's truncation
 // becomes .TRUNC), so that the loop would stay scalar. Both lobes are drawn here and
-// one selected, the kernel's direction; the rest is the kernel's code for technique 1
-// of the balance heuristic.
+// one selected, the kernel's direction; the rest is takeTechniqueSample's code
+// (kernels/pixel.h) for technique 1: the balance heuristic's f / (N p_α), [HS14] eq. 4.2.
 SampleTerm brdfTerm(const PixelPass& p, uint32_t index) {
   const kern::MaRandom4 rnd = kern::philoxDraw(p.seedLo, p.seedHi, p.pixelKey, 1u, index);
   const float u1 = kern::uniformFloat(rnd.v[1]), u2 = kern::uniformFloat(rnd.v[2]);

@@ -126,7 +126,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
     float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
     uint seedLo, uint seedHi, int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
-    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity, int spareSamples
+    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity,
+    int spareSamples
 #if MA_OPTIMAL_WEIGHTS
     ,
     __global const float* coefficients  // [pixel·3M + c·M + k]: a_{c,k} (kernels/pixel.h)

@@ -101,9 +101,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const size_t slots = std::max<size_t>(1, size_t(scene.pixelCount()) * statSlots());
   stats_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, slots * accSize);
   device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
-  samples_ = config.sampleCapacity > 0 ? upload(device, withSpareRecord(emptyStoredSamples(scene, config), scene, config),
-                                                CL_MEM_READ_WRITE)
-                                       : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
+  samples_ = config.sampleCapacity > 0
+                 ? upload(device, withSpareRecord(emptyStoredSamples(scene, config), scene, config), CL_MEM_READ_WRITE)
+                 : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
   const size_t pixels = size_t(scene.pixelCount()), M = size_t(scene.techniqueCount());
   counts_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(int32_t));
   firstIndex_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(uint32_t));
