@@ -9,12 +9,12 @@
 //
 //   build/bench/misalloc_bench_joint_bound [--envmap M]... [--size 128x128]
 //       [--probe-spp 512] [--grid-u 80] [--cost 1,1]
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <array>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "KernelCode.h"
@@ -112,6 +112,7 @@ std::vector<ProbeSample> probePixel(const Scene& scene, kern::EnvmapView env, in
   kern::TechniqueSet ts;
   ts.techniqueCount = 2;
   ts.splitBrdf = 0;
+  ts.product.tables = 0;
   ts.mirror = kern::makeVec3(scene.mirror[0], scene.mirror[1], scene.mirror[2]);
   const PhongParameters& p = scene.grid.pixels[pixel];
   kern::PhongParams b;
@@ -123,7 +124,7 @@ std::vector<ProbeSample> probePixel(const Scene& scene, kern::EnvmapView env, in
     int technique = i % 2;
     env.bankEntry = env.brdfBin * env.bankShares + probeShare;
     kern::MaRandom4 rnd = kern::philoxDraw(stream, 0x6a6f696eu, uint32_t(pixel), uint32_t(technique), uint32_t(i));
-    kern::TechniqueSample t = kern::sampleTechnique(ts, env, b, technique, rnd);
+    kern::TechniqueSample t = kern::sampleTechnique(ts, env, b, technique, rnd, 0.0f);
     kern::SampleValue v = kern::evaluateSample(ts, env, b, technique, t);
     int texel = technique == 0 ? t.texel : kern::texelOfDirection(env, t.wi);
     float sinTheta = std::sqrt(t.wi.x * t.wi.x + t.wi.y * t.wi.y);
@@ -206,7 +207,9 @@ int main(int argc, char** argv) {
   const std::array<double, 2> c{parsed[0], parsed[1]};
   fmt::print("{}x{}, probes of {} spp, U = {}, costs {}\n\n", width, height, spp, gridU, costs);
   fmt::print("Each rule's error at equal time, as a gain over α = 1/2 with C = 1/2 (equal):\n\n");
-  fmt::print("| map | C = 1/2 | mismatched (exact today) | nearest | joint | joint over nearest | pixels whose joint share is not the nearest |\n");
+  fmt::print(
+      "| map | C = 1/2 | mismatched (exact today) | nearest | joint | joint over nearest | pixels whose joint share is "
+      "not the nearest |\n");
   fmt::print("|---|---|---|---|---|---|---|\n");
   for (const std::string& map : maps) measure(map, width, height, spp, gridU, c);
 }

@@ -189,9 +189,26 @@ MA_FN EnvmapSample envmapSampleIn(EnvmapView env, int t, float jitterU, float ji
   return s;
 }
 
-// The bank: a block from the entry's table (rnd.v[0], v[1]), a slot of the block from its
-// alias table: the top 2L bits of rnd.v[2] pick the slot, the rest are the coin, exactly
-// uniform and independent of it. The jitter in the texel takes 16 bits of rnd.v[3] each.
+// A texel of `block` from its alias table over its 2^L × 2^L slots (`slotTables`, as
+// writeBlockSlotTables lays them out): the top 2L bits of rnd.v[2] pick the slot, the
+// rest are the coin, exactly uniform and independent of it. The jitter in the texel
+// takes 16 bits of rnd.v[3] each. The optimal pdf's bank and the product technique
+// (kernels/product.h) draw their texels so.
+MA_FN EnvmapSample sampleTexelInBlock(EnvmapView env, MA_GLOBAL const ma_uint* slotTables, int block, int across,
+                                      int blockLog2, MaRandom4 rnd) {
+  int slotBits = 2 * blockLog2;
+  MA_GLOBAL const ma_uint* slots = slotTables + 2 * (block << slotBits);
+  int slot = (int)(rnd.v[2] >> (32 - slotBits));
+  ma_ulong entry = ma_load64(slots, slot);  // acceptance bits, alias
+  slot = uniformFloat(rnd.v[2] << slotBits) < ma_as_float(lowWord(entry)) ? slot : (int)highWord(entry);
+  int blockRow = rowOfIndex(block, across);
+  int row = (blockRow << blockLog2) + (slot >> blockLog2);
+  int col = ((block - blockRow * across) << blockLog2) + (slot & ((1 << blockLog2) - 1));
+  return envmapSampleIn(env, row * env.width + col, (float)(rnd.v[3] >> 16) * (1.0f / 65536.0f),
+                        (float)(rnd.v[3] & 0xffffu) * (1.0f / 65536.0f));
+}
+
+// The bank: a block from the entry's table (rnd.v[0], v[1]), then a texel in it.
 MA_FN EnvmapSample sampleEnvmapBank(EnvmapView env, MaRandom4 rnd) {
   int across = blocksAcross(env), down = blocksDown(env), blocks = across * down;
   int slotBits = 2 * env.blockLog2;
@@ -199,15 +216,7 @@ MA_FN EnvmapSample sampleEnvmapBank(EnvmapView env, MaRandom4 rnd) {
                                           across, down, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
                          : sampleAliasTable(env.aliasTable + 2 * ((blocks << slotBits) + env.bankEntry * blocks),
                                             (ma_uint)blocks, rnd.v[0], uniformFloat(rnd.v[1]));
-  MA_GLOBAL const ma_uint* slots = env.aliasTable + 2 * (block << slotBits);
-  int slot = (int)(rnd.v[2] >> (32 - slotBits));
-  ma_ulong entry = ma_load64(slots, slot);  // acceptance bits, alias
-  slot = uniformFloat(rnd.v[2] << slotBits) < ma_as_float(lowWord(entry)) ? slot : (int)highWord(entry);
-  int blockRow = rowOfIndex(block, across);
-  int row = (blockRow << env.blockLog2) + (slot >> env.blockLog2);
-  int col = ((block - blockRow * across) << env.blockLog2) + (slot & ((1 << env.blockLog2) - 1));
-  return envmapSampleIn(env, row * env.width + col, (float)(rnd.v[3] >> 16) * (1.0f / 65536.0f),
-                        (float)(rnd.v[3] & 0xffffu) * (1.0f / 65536.0f));
+  return sampleTexelInBlock(env, env.aliasTable, block, across, env.blockLog2, rnd);
 }
 
 // The pdf of a drawn direction is that of the texel it was drawn in (as pbrt-v4's

@@ -8,29 +8,42 @@
 #include "common.h"
 #include "envmap.h"
 #include "phong.h"
+#include "product.h"
 #include "rng.h"
 
 // Technique 0 samples the envmap. With the BRDF as one technique, 1 samples BRDF×cos
 // (the mixture of both lobes); split into lobes, 1 is the cosine lobe, 2 the Phong lobe.
+// With the product technique (kernels/product.h), 2 samples envmap × BRDF × cos.
 #define MA_TECHNIQUE_ENVMAP 0
+#define MA_TECHNIQUE_PRODUCT 2
 
 typedef struct {
-  int techniqueCount;  // M
-  int splitBrdf;       // M = 3: the BRDF's lobes are techniques of their own
-  MaVec3 mirror;       // mirror direction of ω_o about the normal (z)
-  int sharePdfs;       // 1: evaluateSample also gives the envmap's pdf under every share of the bank
+  int techniqueCount;             // M
+  int splitBrdf;                  // M = 3: the BRDF's lobes are techniques of their own
+  MaVec3 mirror;                  // mirror direction of ω_o about the normal (z)
+  ProductView product;            // product.tables > 0: technique 2 is the product technique
+  ProductMixture productMixture;  // the pixel's (productMixture)
+  int sharePdfs;                  // 1: evaluateSample also gives the envmap's pdf under every share of the bank
 } TechniqueSet;
 
 typedef struct {
   MaVec3 wi;
-  int texel;  // technique 0: the envmap texel it drew wi in
+  int texel;  // techniques that draw a texel (drawsTexel): the envmap texel it drew wi in
 } TechniqueSample;
 
-MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd) {
+MA_FN int drawsTexel(TechniqueSet ts, int technique) {
+  return technique == MA_TECHNIQUE_ENVMAP || (ts.product.tables > 0 && technique == MA_TECHNIQUE_PRODUCT);
+}
+
+// mixtureU: the product technique's choice of table (sampleProduct); unused by the others.
+MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd,
+                                      float mixtureU) {
   TechniqueSample s;
   s.texel = 0;
-  if (technique == MA_TECHNIQUE_ENVMAP) {
-    EnvmapSample e = sampleEnvmap(env, rnd);
+  if (drawsTexel(ts, technique)) {
+    EnvmapSample e = technique == MA_TECHNIQUE_ENVMAP
+                         ? sampleEnvmap(env, rnd)
+                         : sampleProduct(env, ts.product, ts.productMixture, rnd, mixtureU);
     s.wi = e.w;
     s.texel = e.texel;
   } else if (!ts.splitBrdf) {
@@ -42,11 +55,16 @@ MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongPara
   return s;
 }
 
-// p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i.
-MA_FN void techniquePdfs(TechniqueSet ts, PhongParams b, MaVec3 wi, float envmapPdf, float lobe, float* pdfs) {
+// p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i, which
+// lies in texel t.
+MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi, int t, float envmapPdf, float lobe,
+                         float* pdfs) {
   pdfs[0] = envmapPdf;
   pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, lobe);
-  pdfs[2] = ts.splitBrdf ? specularPdf(b, lobe) : 0.0f;
+  pdfs[2] = ts.splitBrdf ? specularPdf(b, lobe)
+                         : (ts.product.tables > 0 ? productPdf(env, ts.product, ts.productMixture, t, envmapPdf,
+                                                               ma_sqrt(wi.x * wi.x + wi.y * wi.y))
+                                                  : 0.0f);
 }
 
 // [HS14] eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
@@ -63,12 +81,13 @@ typedef struct {
   float sharePdfs[MA_MAX_BANK_SHARES];  // TechniqueSet::sharePdfs: bankSharePdfs at ω_i, else 0
 } SampleValue;
 
-// f and every p_k at the direction that `technique` drew. A constant `technique` folds
-// the envmap lookup to one of its two cases.
+// f and every p_k at the direction that `technique` drew, in the texel it drew (as
+// sampleEnvmap says why) or the one that holds it. A constant `technique` folds the
+// envmap lookup to one of its two cases.
 MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, int technique,
                                  TechniqueSample sample) {
   MaVec3 wi = sample.wi;
-  int texel = technique == MA_TECHNIQUE_ENVMAP ? sample.texel : texelOfDirection(env, wi);
+  int texel = drawsTexel(ts, technique) ? sample.texel : texelOfDirection(env, wi);
   EnvmapHit hit = envmapTexelHit(env, texel, wi);
   float cosTheta = ma_max(wi.z, 0.0f);
   float lobe = phongLobe(b, wi, ts.mirror);
@@ -77,7 +96,7 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b,
   s.r = hit.r * brdfCos;
   s.g = hit.g * brdfCos;
   s.b = hit.b * brdfCos;
-  techniquePdfs(ts, b, wi, hit.pdf, lobe, s.pdfs);
+  techniquePdfs(ts, env, b, wi, texel, hit.pdf, lobe, s.pdfs);
   MA_UNROLL
   for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
   if (ts.sharePdfs) bankSharePdfs(env, texel, ma_sqrt(wi.x * wi.x + wi.y * wi.y), s.sharePdfs);

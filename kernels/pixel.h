@@ -53,8 +53,8 @@ typedef struct {
   float y;        // Y(f)
   float pdfs[MA_MAX_TECHNIQUES];
   float sharePdfs[MA_MAX_BANK_SHARES];  // SampleValue::sharePdfs
-  float fr, fg, fb;  // f itself, for the optimal weights and their sums (stats.h)
-  float invP;        // 1/p_α (balance), 1/Σ_k p_k (count-independent); 0 where it is 0
+  float fr, fg, fb;                     // f itself, for the optimal weights and their sums (stats.h)
+  float invP;                           // 1/p_α (balance), 1/Σ_k p_k (count-independent); 0 where it is 0
 } SampleContribution;
 
 typedef struct {
@@ -71,6 +71,15 @@ MA_FN void stageFractions(StageCounts c, float* alpha) {
   alpha[2] = (float)c.n2 / N;
 }
 
+// The envmap share C by which a stage picks the optimal pdf's bank entry ([Kar19] eq. 9,
+// q = (1−C) p_ρ): α_0, or with the product technique n_0 against n_0 + n_1. The product's
+// samples, ∝ f, shrink the f that the other two share and leave their ratio to C. From
+// the counts, one division: α_0 and α_1 divided together would be packed into a short
+// vector, which stops PoCL vectorising the sample loop (docs/pocl.md, rule 8).
+MA_FN float bankEnvmapFraction(int product, int n0, int n1, float alpha0) {
+  return product ? (float)n0 / (float)(n0 + n1 > 0 ? n0 + n1 : 1) : alpha0;
+}
+
 // The sample of `technique` with that technique's sample index `index`.
 MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c,
                                              int technique, ma_uint index, ma_uint seedLo, ma_uint seedHi,
@@ -78,7 +87,8 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float N = (float)c.stageSamples;
   float alpha[MA_MAX_TECHNIQUES];
   stageFractions(c, alpha);
-  if (env.bankShares > 0) env.bankEntry = bankEntryOf(env, alpha[0]);
+  if (env.bankShares > 0)
+    env.bankEntry = bankEntryOf(env, bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]));
   SampleValue s;
   float invP, scale;
   if (technique == MA_TECHNIQUE_ENVMAP && c.risCandidates > 0) {
@@ -89,7 +99,11 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
     scale = N;
   } else {
     MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
-    s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd));
+    // The product technique's choice of table takes a word of the draw's next part.
+    float mixtureU = drawsTexel(ts, technique) && technique != MA_TECHNIQUE_ENVMAP
+                         ? uniformFloat(philoxDrawPart(seedLo, seedHi, pixel, (ma_uint)technique, index, 1u).v[0])
+                         : 0.0f;
+    s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd, mixtureU));
     // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent
     // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) ([SHS16] eq. 26).
     float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
@@ -103,7 +117,9 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   }
   SampleContribution out;
   out.technique = technique;
-  out.share = env.bankShares > 0 ? bankShareOf(env.bankShares, alpha[0]) : 0;
+  out.share = env.bankShares > 0
+                  ? bankShareOf(env.bankShares, bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]))
+                  : 0;
   out.r = s.r * invP / scale;
   out.g = s.g * invP / scale;
   out.b = s.b * invP / scale;

@@ -46,7 +46,7 @@ MA_FN ResampledSample resampleEnvmap(TechniqueSet ts, EnvmapView env, PhongParam
     if (i % 4 == 0) coins = philoxDrawPart(seedLo, seedHi, pixel, MA_STREAM_RESAMPLING_CHOICE, index, (ma_uint)(i / 4));
     MaRandom4 rnd = philoxDrawPart(seedLo, seedHi, pixel, (ma_uint)MA_TECHNIQUE_ENVMAP, index, (ma_uint)i);
     SampleValue x = evaluateSample(ts, env, b, MA_TECHNIQUE_ENVMAP,
-                                   sampleTechnique(ts, env, b, MA_TECHNIQUE_ENVMAP, rnd));
+                                   sampleTechnique(ts, env, b, MA_TECHNIQUE_ENVMAP, rnd, 0.0f));
     // [TCE05]: w = p̂/p. A candidate's texel was drawn, so p > 0 but for underflow.
     float w = x.pdfs[0] > 0.0f ? luminance(x.r, x.g, x.b) / x.pdfs[0] : 0.0f;
     weightSum += w;

@@ -6,7 +6,9 @@
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
 // MA_COSK (< 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
 // bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
-// (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h), MA_STATS (the
+// (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h),
+// MA_PRODUCT_TABLES, MA_PRODUCT_BLOCK_LOG2 and MA_PRODUCT_PLAIN_TEXELS (the product
+// technique's tables, kernels/product.h; 0: none), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
 // weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE.
@@ -50,15 +52,28 @@ enum {
   ROW_FIRST2,
   ROW_COEFFICIENTS  // --weights optimal: a_{c,k} at row ROW_COEFFICIENTS + c·M + k
 };
-#define ROW_COUNT (ROW_COEFFICIENTS + (MA_OPTIMAL_WEIGHTS ? 3 * MA_TECHNIQUES : 0))
+// --product: the pixel's ProductMixture (diffuse, specular, specular table) after them.
+#define ROW_PRODUCT (ROW_COEFFICIENTS + (MA_OPTIMAL_WEIGHTS ? 3 * MA_TECHNIQUES : 0))
+#define ROW_COUNT (ROW_PRODUCT + (MA_PRODUCT_TABLES > 0 ? 3 : 0))
+
+MA_FN ProductView productView(__global const float* productFloats, __global const uint* productWords) {
+  ProductView p;
+  p.floats = productFloats;
+  p.words = productWords;
+  p.tables = MA_PRODUCT_TABLES;
+  p.blockLog2 = MA_PRODUCT_BLOCK_LOG2;
+  p.plainTexels = MA_PRODUCT_PLAIN_TEXELS;
+  return p;
+}
 
 // Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
 // The envmap tables are read where the sample falls: they are the gathers that remain.
 // The random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
 // image's rows (host/render/Band.h) draws the samples the whole image's render draws.
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
-                                       __global const uint* aliasTable, __global const float* blockProbs, int width,
-                                       int height, __local const int* pixelRows, int lid, MaVec3 mirror,
+                                       __global const uint* aliasTable, __global const float* blockProbs,
+                                       __global const float* productFloats, __global const uint* productWords,
+                                       int width, int height, __local const int* pixelRows, int lid, MaVec3 mirror,
                                        int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
                                        int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*MA_LOCAL_SIZE + lid]
@@ -82,6 +97,10 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   ts.techniqueCount = MA_TECHNIQUES;
   ts.splitBrdf = MA_SPLIT_BRDF;
   ts.mirror = mirror;
+  ts.product = productView(productFloats, productWords);
+  ts.productMixture.diffuse = MA_PRODUCT_TABLES > 0 ? as_float(PIXEL_ROW(ROW_PRODUCT)) : 0.0f;
+  ts.productMixture.specular = MA_PRODUCT_TABLES > 0 ? as_float(PIXEL_ROW(ROW_PRODUCT + 1)) : 0.0f;
+  ts.productMixture.specularTable = MA_PRODUCT_TABLES > 0 ? PIXEL_ROW(ROW_PRODUCT + 2) : 0;
   ts.sharePdfs = MA_SHARE_COLUMNS > 0;
 
   PhongParams b;
@@ -123,11 +142,11 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
     __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable,
-    __global const float* blockProbs, int width, int height, __global const float* brdfParams, float mirrorX,
-    float mirrorY, float mirrorZ, __global const int* counts, __global const uint* firstIndex, int stageSamples,
-    uint seedLo, uint seedHi, int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate,
-    __global ma_acc* moments, __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity,
-    int spareSamples
+    __global const float* blockProbs, __global const float* productFloats, __global const uint* productWords, int width,
+    int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
+    __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
+    int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate, __global ma_acc* moments,
+    __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity, int spareSamples
 #if MA_OPTIMAL_WEIGHTS
     ,
     __global const float* coefficients  // [pixel·3M + c·M + k]: a_{c,k} (kernels/pixel.h)
@@ -162,6 +181,16 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
     pixelRows[(ROW_COEFFICIENTS + r) * MA_LOCAL_SIZE + lid] = as_int(coefficients[pixel * 3 * MA_TECHNIQUES + r]);
 #endif
+#if MA_PRODUCT_TABLES > 0
+  PhongParams brdf;
+  brdf.rhoD = brdfParams[4 * pixel + 0];
+  brdf.rhoS = brdfParams[4 * pixel + 1];
+  brdf.n = brdfParams[4 * pixel + 2];
+  ProductMixture mixture = productMixture(productView(productFloats, productWords), brdf);
+  pixelRows[ROW_PRODUCT * MA_LOCAL_SIZE + lid] = as_int(mixture.diffuse);
+  pixelRows[(ROW_PRODUCT + 1) * MA_LOCAL_SIZE + lid] = as_int(mixture.specular);
+  pixelRows[(ROW_PRODUCT + 2) * MA_LOCAL_SIZE + lid] = mixture.specularTable;
+#endif
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
   // sampler only. A work-group runs its largest n_k; the other work-items' surplus
@@ -178,9 +207,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
-      SampleContribution c =
-          sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, width, height, pixelRows, lid,
-                        makeVec3(mirrorX, mirrorY, mirrorZ), stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+      SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width,
+                                           height, pixelRows, lid, makeVec3(mirrorX, mirrorY, mirrorZ), stageSamples,
+                                           seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;

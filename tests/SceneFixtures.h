@@ -14,7 +14,7 @@ namespace misalloc::test {
 
 inline Scene smallScene(const std::string& envmap, const std::string& grid, int w, int h, bool split = false,
                         EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0,
-                        const std::string& envmapPdf = "plain") {
+                        const std::string& envmapPdf = "plain", bool product = false) {
   SceneOptions o;
   o.envmapPdf = parseEnvmapPdf(envmapPdf);
   o.envmap = envmap;
@@ -22,6 +22,7 @@ inline Scene smallScene(const std::string& envmap, const std::string& grid, int 
   o.width = w;
   o.height = h;
   o.splitBrdf = split;
+  o.product = product;
   o.sampler = sampler;
   o.viewTheta = viewTheta;
   o.proceduralWidth = 128;

@@ -112,21 +112,22 @@ TEST_CASE("launch shape: PoCL's CPU device: its limits, and 8 work-items", "[lau
 TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
   const Device& device = testDevice();
   const bool doubleSums = hasFp64(device.device);
-  for (bool split : {false, true}) {
-    Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split);
+  for (int techniques : {0, 1, 2}) {  // the BRDF as one technique, split, or with the product
+    const bool split = techniques == 1, product = techniques == 2;
+    Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split, EnvmapSampler::Alias, 0, "plain", product);
     for (Method method : {Method::Equal, Method::Heuristic, Method::Linear})
       for (MisWeights weights : {MisWeights::Balance, MisWeights::Optimal}) {
         AdaptiveOptions options;
         options.weights = weights;
         SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 64, options);
         const int statSlots = HostSampler(scene, config).statSlots();
-        const int coefficientRows = weights == MisWeights::Optimal ? 3 * scene.techniqueCount() : 0;
+        const int optionalRows = (weights == MisWeights::Optimal ? 3 * scene.techniqueCount() : 0) + (product ? 3 : 0);
         for (int localSize : {8, 64}) {
-          CAPTURE(split, methodName(method), misWeightsName(weights), localSize);
+          CAPTURE(split, product, methodName(method), misWeightsName(weights), localSize);
           cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)),
                             "sampleStage");
           CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
-                sampleKernelLocalBytes(localSize, statSlots, doubleSums, coefficientRows));
+                sampleKernelLocalBytes(localSize, statSlots, doubleSums, optionalRows));
         }
       }
   }

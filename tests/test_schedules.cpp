@@ -136,6 +136,10 @@ TEST_CASE("the refused schedules are those that would be biased", "[unbiased][sc
   CHECK_THROWS_WITH(requireValidRun(split, Method::Exact, Estimator::MultiSample, 16, fiveStages),
                     Catch::Contains("the specular lobe alone misses the diffuse lobe"));
   CHECK_NOTHROW(requireValidRun(split, Method::Equal, Estimator::MultiSample, 1, {}));
+  // The product technique alone covers, like either of the others with the plain pdf.
+  SceneOptions product;
+  product.product = true;
+  CHECK_NOTHROW(requireValidRun(product, Method::Exact, Estimator::MultiSample, 16, fiveStages));
   CHECK_THROWS_AS(requireValidRun(compensated, Method::Equal, Estimator::OneSample, 1, {}), InputError);
   CHECK_THROWS_AS(requireValidRun(compensated, Method::Oracle, Estimator::MultiSample, 1, {}), InputError);
   // The coverage rule itself.
@@ -143,6 +147,10 @@ TEST_CASE("the refused schedules are those that would be biased", "[unbiased][sc
   CHECK_FALSE(coversIntegrand(0b01, 2, compensated.envmapPdf, Estimator::MultiSample));
   CHECK(coversIntegrand(0b10, 2, compensated.envmapPdf, Estimator::OneSample));
   CHECK_FALSE(coversIntegrand(0b100, 3, EnvmapPdf{}, Estimator::MultiSample));
+  // The product technique covers wherever the map is lit, whatever the envmap pdf.
+  CHECK(coversIntegrand(0b100, 3, compensated.envmapPdf, Estimator::MultiSample, true));
+  CHECK(coversIntegrand(0b100, 3, compensated.envmapPdf, Estimator::OneSample, true));
+  CHECK_FALSE(coversIntegrand(0b100, 3, EnvmapPdf{}, Estimator::CountIndependent, true));
   CHECK(coversIntegrand(0b010, 3, compensated.envmapPdf, Estimator::MultiSample));
   CHECK_FALSE(coversIntegrand(0b10, 2, EnvmapPdf{}, Estimator::CountIndependent));
   CHECK(coversIntegrand(0b11, 2, EnvmapPdf{}, Estimator::CountIndependent));

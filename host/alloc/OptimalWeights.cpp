@@ -91,7 +91,8 @@ int envmapTableOf(const Scene& scene, const int32_t* counts) {
   kern::EnvmapView view = makeEnvmapView(scene.tables, scene.envmap.coskExponent);
   int total = 0;
   for (int k = 0; k < scene.techniqueCount(); ++k) total += counts[k];
-  return kern::bankEntryOf(view, (float)counts[0] / (float)total);  // the kernels' stageFractions
+  const float alpha0 = (float)counts[0] / (float)total;  // the kernels' stageFractions
+  return kern::bankEntryOf(view, kern::bankEnvmapFraction(scene.productTables.enabled(), counts[0], counts[1], alpha0));
 }
 
 StageCoefficients optimalCoefficients(StageStatistics& stages, int poolRadius, const StagePlan& first,

@@ -62,10 +62,10 @@ DeviceLimits deviceLimits(const cl::Device& device) {
   return limits;
 }
 
-size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int coefficientRows) {
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int optionalRows) {
   const size_t acc = doubleSums ? sizeof(double) : sizeof(float);
   return size_t(localSize) *
-         ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + size_t(coefficientRows) + 1) * sizeof(cl_int));
+         ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + size_t(optionalRows) + 1) * sizeof(cl_int));
 }
 
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,
@@ -75,8 +75,8 @@ LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size
   if (overrideLocalSize > 0) {
     const size_t bytes = localBytes(overrideLocalSize);
     if (auto why = misfit(limits, bytes, overrideLocalSize))
-      throw DeviceError(fmt::format("--local-size {}: the sampling kernel does not fit this {}: {}", overrideLocalSize,
-                                   kind, *why));
+      throw DeviceError(
+          fmt::format("--local-size {}: the sampling kernel does not fit this {}: {}", overrideLocalSize, kind, *why));
     return {overrideLocalSize, fmt::format("{}: {} work-items as --local-size asked, {} of {} local memory", kind,
                                            overrideLocalSize, kib(bytes), kib(limits.localMemBytes))};
   }
@@ -98,8 +98,8 @@ LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size
       refused = why;
       continue;
     }
-    std::string line = fmt::format("{}: {} work-items, {} of {} local memory", kind, size, kib(bytes),
-                                   kib(limits.localMemBytes));
+    std::string line =
+        fmt::format("{}: {} work-items, {} of {} local memory", kind, size, kib(bytes), kib(limits.localMemBytes));
     if (limits.cpu && size == kCpuLocalSize) line += " (PoCL vectorises 8 best, docs/pocl.md rule 4)";
     if (refused) line += "; " + *refused;
     return {size, line};

@@ -29,9 +29,10 @@ DeviceLimits deviceLimits(const cl::Device& device);
 // (`statSlots`, StageStatistics::statSlots()), in double where `doubleSums` (ma_acc,
 // kernels/common.h) else float, and per work-item its pixel's rows and pass count. With no running sums the kernel
 // declares a one-row placeholder that it never touches: PoCL and clang's nvptx64
-// back end both drop it, so it is not counted. `coefficientRows`: the optimal weights'
-// coefficients among the pixel's rows (3M with --weights optimal, else 0).
-size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int coefficientRows);
+// back end both drop it, so it is not counted. `optionalRows`: the pixel's rows that
+// only some kernels have: the optimal weights' coefficients (3M with --weights optimal)
+// and the product technique's mixture (3 with --product).
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int optionalRows);
 
 struct LaunchShape {
   int localSize = 0;

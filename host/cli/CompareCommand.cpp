@@ -83,6 +83,7 @@ int runCompare(CompareArgs& args) {
     for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
       c.scene.viewTheta = probe.options.viewTheta;
       c.scene.viewPhi = probe.options.viewPhi;
+      c.scene.product = probe.options.product;  // the suite with the product technique in every case
       compare.cases.push_back(c);
     }
   } else {
@@ -198,11 +199,13 @@ Subcommand addCompareCommand(CLI::App& app) {
   command->add_option("--out-dir", compare.outDir, "output folder (created if missing)")->required();
   args->devices.add(*command, "comma-separated: auto, cpu, gpu, an index, host (C++), all, or D:N (sub-devices)");
   command->add_option("--local-size", compare.localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
-  command->add_option("--reference-spp", compare.referenceSpp,
-                      "spp of a sampled reference (default: 64 x the largest budget, at least 16384)")
+  command
+      ->add_option("--reference-spp", compare.referenceSpp,
+                   "spp of a sampled reference (default: 64 x the largest budget, at least 16384)")
       ->check(integerIn(1, INT_MAX));
   compare.cacheDir = defaultCacheDir();
-  command->add_option("--cache-dir", compare.cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
+  command->add_option("--cache-dir", compare.cacheDir, "where references and the optimal pdf's tables are cached")
+      ->capture_default_str();
   auto* shardOption = command->add_option(
       "--shard", args->shard,
       "K/N: run shard K of N (every N-th unit of --shard-unit) into --out-dir, for `misalloc merge --out-dir`");

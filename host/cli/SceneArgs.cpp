@@ -24,6 +24,8 @@ void SceneArgs::add(CLI::App& command) {
   command.add_option("--view", view, "view direction: polar angle THETA[,PHI] in degrees")->capture_default_str();
   command.add_flag("--split-brdf", options.splitBrdf,
                    "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
+  command.add_flag("--product", options.product,
+                   "envmap × BRDF × cos, tabulated per block of texels, as a third technique (M=3; [CL18])");
   command.add_option("--envmap-sampler", sampler, "alias (O(1)) or cdf (two binary searches)")->capture_default_str();
   command.add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
       ->capture_default_str()

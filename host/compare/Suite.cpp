@@ -13,6 +13,7 @@ std::string caseLabel(const SceneOptions& scene) {
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
   if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";
   if (scene.splitBrdf) name += "-split";
+  if (scene.product) name += "-product";
   if (scene.envmapPdf.compensated()) name += "-comp" + envmapPdfName(scene.envmapPdf).substr(sizeof("compensated"));
   if (scene.envmapPdf.optimal()) name += "-optimal";
   return name;

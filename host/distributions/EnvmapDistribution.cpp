@@ -17,7 +17,6 @@
 namespace misalloc {
 namespace {
 
-
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
 
 void requireValidSize(const Envmap& envmap) {
@@ -116,7 +115,15 @@ void storeDrawnProbabilities(const float* cdf, int width, int height, float* out
   }
 }
 
-// Acceptance probability and alias of each bucket, interleaved.
+// ceil(log2(n)), 0 for n = 1: searchCdf halves its range rounding up.
+int binarySearchSteps(int n) {
+  int steps = 0;
+  while ((int64_t(1) << steps) < n) ++steps;
+  return steps;
+}
+
+}  // namespace
+
 std::vector<uint32_t> interleave(const AliasTable& alias) {
   std::vector<uint32_t> table(2 * alias.probability.size());
   for (std::size_t b = 0; b < alias.probability.size(); ++b) {
@@ -126,17 +133,6 @@ std::vector<uint32_t> interleave(const AliasTable& alias) {
   return table;
 }
 
-// ceil(log2(n)), 0 for n = 1: searchCdf halves its range rounding up.
-int binarySearchSteps(int n) {
-  int steps = 0;
-  while ((int64_t(1) << steps) < n) ++steps;
-  return steps;
-}
-
-// Each block's alias table over its 2^L × 2^L slots (row-major in the block), ∝ the
-// texels' weights, at table[2 · (block · 4^L + slot)]; slots past the map's edge weigh
-// 0. A block of no weight is never drawn; its table is uniform over its texels so that
-// it stays valid.
 void writeBlockSlotTables(const std::vector<double>& weights, int width, int height, int blockLog2, uint32_t* table) {
   const int side = 1 << blockLog2, slotCount = side * side;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
@@ -168,7 +164,12 @@ void writeBlockSlotTables(const std::vector<double>& weights, int width, int hei
   }
 }
 
-}  // namespace
+std::vector<double> plainTexelWeights(const RgbImage& image) {
+  std::vector<double> weights = sinThetaWeighted(texelLuminance(image), image.width, image.height);
+  double total = 0;
+  for (double w : weights) total += w;
+  return total > 0 ? weights : sphereWeights(image.width, image.height);
+}
 
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf) {
   requireValidSize(envmap);

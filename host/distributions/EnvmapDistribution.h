@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "distributions/AliasTable.h"
 #include "distributions/CompensatedPdf.h"
 #include "distributions/OptimalBank.h"
 #include "scene/BrdfGrid.h"
@@ -64,6 +65,20 @@ struct EnvmapTables {
 // makeEnvmap make them (else std::invalid_argument). Throws InputError, naming the
 // map, if it has too many texels for the kernels' 32-bit int indexing.
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf = {});
+
+// The texels' luminance × sin θ, the plain pdf's weights; sin θ alone for a black map.
+// The texels must be finite and ≥ 0 (else std::invalid_argument).
+std::vector<double> plainTexelWeights(const RgbImage& image);
+
+// An alias table's acceptance probability and alias of each bucket, interleaved, as
+// kernels/envmap.h's sampleAliasTable reads them.
+std::vector<uint32_t> interleave(const AliasTable& alias);
+
+// Each block's alias table over its 2^L × 2^L slots (row-major in the block), ∝ the
+// texels' weights, at table[2 · (block · 4^L + slot)]; slots past the map's edge weigh
+// 0. A block of no weight is never drawn; its table is uniform over its texels so that
+// it stays valid. kernels/envmap.h's sampleTexelInBlock reads it.
+void writeBlockSlotTables(const std::vector<double>& weights, int width, int height, int blockLog2, uint32_t* table);
 
 // The optimal pdf for the grid's BRDFs seen from `mirror`: the bank of block tables
 // (alias or CDF, as `sampler`), each block's texels drawn by alias tables ∝ luminance ×

@@ -5,11 +5,11 @@
 
 #include "Constants.h"
 #include "KernelCode.h"
+#include "distributions/BlockCells.h"
 #include "distributions/CompensatedPdf.h"
 
 namespace misalloc {
 namespace {
-
 
 // x in [lo, hi] cut into `bins` equal bins: the index of the one holding x (its nearest
 // centre). One bin where the range is empty.
@@ -76,45 +76,11 @@ double bankShare(int i, int shares) { return double(i + 1) / double(shares + 1);
 OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, int width, int height,
                                        const BrdfBins& bins, const std::array<float, 3>& mirror,
                                        const OptimalBankOptions& options) {
-  const int side = 1 << options.blockLog2;
-  const int across = (width + side - 1) / side, down = (height + side - 1) / side;
-  const std::size_t blocks = std::size_t(across) * down;
-  // f and p_ρ are taken at the centres of cells of 4 × 4 texels, each cell weighted by
-  // its texels' plain weights and solid angles: 16 evaluations per 8 × 8 block, which
-  // keeps the bank's build a few percent of a render's time.
-  const int cellLog2 = std::min(options.blockLog2, 2), cellSide = 1 << cellLog2;
-  const int cellsAcross = (width + cellSide - 1) / cellSide, cellsDown = (height + cellSide - 1) / cellSide;
-  struct Cell {
-    kern::MaVec3 direction;
-    double plain = 0, solidAngle = 0;  // Σ luminance × sin θ, Σ sin θ
-    std::size_t block = 0;
-  };
-  std::vector<Cell> cells(std::size_t(cellsAcross) * cellsDown);
+  const BlockCells grid = blockCells(plainWeights, width, height, options.blockLog2);
+  const std::size_t blocks = grid.plainBlockMass.size();
   OptimalBankWeights bank;
-  std::vector<double>& plainMass = bank.plainBlockMass;
-  plainMass.assign(blocks, 0.0);
-  for (int row = 0; row < height; ++row) {
-    const double sinTheta = std::sin(kPi * (row + 0.5) / height);
-    Cell* cellRow = cells.data() + std::size_t(row >> cellLog2) * cellsAcross;
-    double* massRow = plainMass.data() + std::size_t(row >> options.blockLog2) * across;
-    const double* weightRow = plainWeights.data() + std::size_t(row) * width;
-    for (int col = 0; col < width; ++col) {
-      cellRow[col >> cellLog2].plain += weightRow[col];
-      cellRow[col >> cellLog2].solidAngle += sinTheta;
-      massRow[col >> options.blockLog2] += weightRow[col];
-    }
-  }
-  for (int cellRow = 0; cellRow < cellsDown; ++cellRow)
-    for (int cellCol = 0; cellCol < cellsAcross; ++cellCol) {
-      Cell& cell = cells[std::size_t(cellRow) * cellsAcross + cellCol];
-      const double rows = std::min(cellSide, height - cellRow * cellSide);
-      const double cols = std::min(cellSide, width - cellCol * cellSide);
-      const double theta = kPi * (cellRow * cellSide + 0.5 * rows) / height;
-      const double phi = 2 * kPi * (cellCol * cellSide + 0.5 * cols) / width;
-      cell.direction = kern::makeVec3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                                      float(std::cos(theta)));
-      cell.block = std::size_t(cellRow * cellSide / side) * across + cellCol * cellSide / side;
-    }
+  bank.plainBlockMass = grid.plainBlockMass;
+  const std::vector<double>& plainMass = bank.plainBlockMass;
   const int binCount = int(bins.centres.size()), shares = options.shares;
   bank.entries.resize(std::size_t(binCount) * shares);
   std::vector<double> compensatedRatio(bank.entries.size(), 1);
@@ -128,7 +94,7 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
     b.n = bins.centres[bin].n;
     // f = L ρ cos and p_ρ integrated over each block.
     std::vector<double> f(blocks, 0.0), brdf(blocks, 0.0);
-    for (const Cell& cell : cells) {
+    for (const BlockCell& cell : grid.cells) {
       const float lobe = kern::phongLobe(b, cell.direction, r);
       f[cell.block] += cell.plain * kern::phongBrdf(b, lobe) * std::max(cell.direction.z, 0.0f);
       brdf[cell.block] += cell.solidAngle * kern::brdfPdf(b, cell.direction, lobe);

@@ -22,7 +22,6 @@ namespace {
 constexpr uint32_t kReferenceFirstIndex = 1u << 31;
 constexpr uint64_t kReferenceSeed = 0x8000000000005eedull;
 
-
 }  // namespace
 
 std::optional<RgbImage> analyticReference(const Scene& scene) {
@@ -41,6 +40,8 @@ std::optional<RgbImage> analyticReference(const Scene& scene) {
 
 Scene referenceScene(const Scene& scene) {
   SceneOptions options = scene.options;
+  // The same reference with or without the product technique, which changes the noise only.
+  options.product = false;
   options.envmapPdf = options.splitBrdf ? EnvmapPdf{} : parseEnvmapPdf("optimal");
   return makeScene(options);
 }
@@ -54,9 +55,10 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
   constexpr int kMaxBatch = 4096, kBatches = 16;
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();
   if (spp < 2 * M)
-    throw InputError(fmt::format("--reference-spp {}: a sampled reference needs two batches of {} samples, one per "
-                                 "technique each, to estimate its own variance",
-                                 spp, M));
+    throw InputError(
+        fmt::format("--reference-spp {}: a sampled reference needs two batches of {} samples, one per "
+                    "technique each, to estimate its own variance",
+                    spp, M));
   const int batches = std::max(std::min(kBatches, spp / M), (spp + kMaxBatch - 1) / kMaxBatch);
   // Per pixel and channel: Σ_b n_b x_b and Σ_b n_b x_b² over the batches' estimates x_b.
   std::vector<double> sum(size_t(pixels) * 3, 0.0), sumSquares(sum.size(), 0.0);
@@ -146,8 +148,7 @@ ExrAttributes cacheClaims(const std::string& key, const Scene& scene, int spp, c
           {"misalloc.reference.checksum", fmt::format("{:016x}", pixelChecksum(reference))}};
 }
 
-std::string encodeCacheEntry(const std::string& key, const Scene& scene, int spp,
-                             const SampledReference& reference) {
+std::string encodeCacheEntry(const std::string& key, const Scene& scene, int spp, const SampledReference& reference) {
   std::vector<std::vector<float>> planes(6, std::vector<float>(reference.standardError.size() / 3));
   for (size_t p = 0; p < planes[0].size(); ++p)
     for (int c = 0; c < 3; ++c) {
@@ -183,8 +184,7 @@ CacheEntry readCacheEntry(const std::string& path, const std::string& key, const
   for (const auto& [name, expected] : cacheClaims(key, scene, spp, entry)) {
     auto it = found.find(name);
     if (it == found.end()) return {std::nullopt, fmt::format("it has no {}", name)};
-    if (it->second != expected)
-      return {std::nullopt, fmt::format("its {} is {}, not {}", name, it->second, expected)};
+    if (it->second != expected) return {std::nullopt, fmt::format("its {} is {}, not {}", name, it->second, expected)};
   }
   return {std::move(entry), ""};
 }

@@ -13,6 +13,9 @@ constexpr unsigned kEnvmapTechnique = 1u << 0;
 // The BRDF (M = 2) or its diffuse lobe (M = 3): either covers every direction where the
 // BRDF is non-zero.
 constexpr unsigned kCoveringBrdfTechnique = 1u << 1;
+// The product technique (--product): its plain envmap share (kernels/product.h) covers
+// every direction where the map is lit, whatever the envmap technique's pdf.
+constexpr unsigned kProductTechnique = 1u << 2;
 
 unsigned allTechniques(int M) { return (1u << M) - 1; }
 
@@ -33,10 +36,10 @@ unsigned fixedSplitTechniques(Method method, int M, int spp) {
 
 // An allocated stage of `samples` samples: all techniques once the floor can give each
 // one, else any single technique.
-bool allocatedStageCovers(int samples, int M, const EnvmapPdf& pdf, Estimator estimator) {
-  if (samples >= M) return coversIntegrand(allTechniques(M), M, pdf, estimator);
+bool allocatedStageCovers(int samples, int M, const EnvmapPdf& pdf, Estimator estimator, bool product) {
+  if (samples >= M) return coversIntegrand(allTechniques(M), M, pdf, estimator, product);
   for (int k = 0; k < M; ++k)
-    if (!coversIntegrand(1u << k, M, pdf, estimator)) return false;
+    if (!coversIntegrand(1u << k, M, pdf, estimator, product)) return false;
   return true;
 }
 
@@ -44,9 +47,10 @@ std::string biasReason(const EnvmapPdf& pdf, Estimator estimator, int M) {
   if (estimator == Estimator::CountIndependent)
     return "the count-independent estimator ([SHS16] eq. 26) needs a sample of every technique in every stage";
   if (!pdf.plain())
-    return fmt::format("the {} envmap pdf is zero where the radiance is low, so BRDF sampling must take a sample in "
-                       "every stage",
-                       envmapPdfName(pdf));
+    return fmt::format(
+        "the {} envmap pdf is zero where the radiance is low, so BRDF sampling must take a sample in "
+        "every stage",
+        envmapPdfName(pdf));
   return M == 3 ? "the specular lobe alone misses the diffuse lobe, so every stage needs a sample of each technique"
                 : "every stage needs a sample of each technique";
 }
@@ -64,16 +68,17 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
         traits.name, envmapPdfName(pdf),
         traits.estimator == Estimator::Resampled ? "resampling envmap candidates ([TCE05])" : "envmap sampling alone"));
   if (traits.split == Split::Fixed) {
-    if (coversIntegrand(fixedSplitTechniques(method, M, spp), M, pdf, estimator)) return;
-    throw InputError(fmt::format("--spp {} with --method {}{}: the split leaves a technique without samples, and {}; "
-                                 "raise --spp",
-                                 spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf),
-                                 biasReason(pdf, estimator, M)));
+    if (coversIntegrand(fixedSplitTechniques(method, M, spp), M, pdf, estimator, scene.product)) return;
+    throw InputError(
+        fmt::format("--spp {} with --method {}{}: the split leaves a technique without samples, and {}; "
+                    "raise --spp",
+                    spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf),
+                    biasReason(pdf, estimator, M)));
   }
   std::vector<int> sizes{spp};
   if (traits.split == Split::Staged) sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
   const int smallest = *std::min_element(sizes.begin(), sizes.end());
-  if (!allocatedStageCovers(smallest, M, pdf, traits.estimator))
+  if (!allocatedStageCovers(smallest, M, pdf, traits.estimator, scene.product))
     throw InputError(fmt::format(
         "--spp {} with --method {}{}: a stage of {} sample(s) cannot give each of the {} techniques one, and {}; "
         "raise --spp{}",
@@ -125,10 +130,11 @@ bool takesOptimalWeights(Method method, Estimator estimator) {
                            : method == Method::Equal && estimator == Estimator::MultiSample;
 }
 
-bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator) {
+bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator, bool product) {
   if (estimator == Estimator::CountIndependent) return sampled == allTechniques(techniqueCount);
   if (estimator == Estimator::Resampled) return pdf.plain() && (sampled & kEnvmapTechnique);
   if (pdf.plain() && (sampled & kEnvmapTechnique)) return true;
+  if (product && (sampled & kProductTechnique)) return true;
   return (sampled & kCoveringBrdfTechnique) != 0;
 }
 

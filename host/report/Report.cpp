@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "KernelCode.h"
 #include "report/RunSummary.h"
 
 namespace misalloc {
@@ -96,17 +97,25 @@ nlohmann::json weightsJson(MisWeights weights, const Rendering& r, const RunSumm
 
 nlohmann::json sceneJson(const Scene& scene) {
   const SceneOptions& o = scene.options;
-  return {{"envmap", o.envmap},
-          {"envmap_file", scene.envmapPath},
-          {"envmap_size", {scene.tables.width, scene.tables.height}},
-          {"envmap_uniform_fallback", scene.tables.uniformFallback},
-          {"envmap_negative_values_zeroed", scene.envmapWarnings.negativeValues},
-          {"grid", o.grid},
-          {"size", {o.width, o.height}},
-          {"view_deg", {o.viewTheta, o.viewPhi}},
-          {"techniques", scene.techniqueNames()},
-          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
-          {"envmap_pdf", envmapPdfJson(scene.tables)}};
+  nlohmann::json json = {{"envmap", o.envmap},
+                         {"envmap_file", scene.envmapPath},
+                         {"envmap_size", {scene.tables.width, scene.tables.height}},
+                         {"envmap_uniform_fallback", scene.tables.uniformFallback},
+                         {"envmap_negative_values_zeroed", scene.envmapWarnings.negativeValues},
+                         {"grid", o.grid},
+                         {"size", {o.width, o.height}},
+                         {"view_deg", {o.viewTheta, o.viewPhi}},
+                         {"techniques", scene.techniqueNames()},
+                         {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
+                         {"envmap_pdf", envmapPdfJson(scene.tables)}};
+  if (scene.productTables.enabled())
+    json["product"] = {{"tables", scene.productTables.tables},
+                       {"specular_tables", scene.productTables.tables - MA_PRODUCT_TABLE_DIFFUSE - 1},
+                       {"block_texels", 1 << (2 * scene.productTables.blockLog2)},
+                       {"plain_share", MA_PRODUCT_PLAIN_SHARE},
+                       {"table_bytes", scene.productTables.bytes()},
+                       {"build_seconds", scene.productTables.buildSeconds}};
+  return json;
 }
 
 nlohmann::json timeSplitJson(double wall, double kernel, double allocation, double host) {
@@ -116,7 +125,8 @@ nlohmann::json timeSplitJson(double wall, double kernel, double allocation, doub
 nlohmann::json stagesJson(const std::vector<StageTiming>& stages) {
   nlohmann::json list = nlohmann::json::array();
   for (const StageTiming& s : stages) {
-    nlohmann::json entry = {{"samples", s.samples}, {"keeps_statistics", s.keptStatistics}, {"kernel_s", s.kernelSeconds}};
+    nlohmann::json entry = {
+        {"samples", s.samples}, {"keeps_statistics", s.keptStatistics}, {"kernel_s", s.kernelSeconds}};
     if (s.predictedKernelSeconds) {
       entry["predicted_kernel_s"] = *s.predictedKernelSeconds;
       entry["predicted_over_measured"] = *s.predictedKernelSeconds / s.kernelSeconds;
@@ -215,7 +225,8 @@ nlohmann::json renderReport(const RenderRun& run) {
     report["rmse_x1000_corrected"] = 1000 * std::sqrt(std::max(0.0, summary.corrected->mse));
     report["mse_corrected"] = summary.corrected->mse;
     report["mse_corrected_standard_error"] = summary.corrected->standardError;
-    report["reference"]["variance_share"] = *summary.mse > 0 ? (*summary.mse - summary.corrected->mse) / *summary.mse : 0.0;
+    report["reference"]["variance_share"] =
+        *summary.mse > 0 ? (*summary.mse - summary.corrected->mse) / *summary.mse : 0.0;
   } else {
     report["reference"] = nullptr;
   }

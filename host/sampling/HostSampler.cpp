@@ -28,6 +28,16 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   return env;
 }
 
+kern::ProductView makeProductView(const ProductTables& t) {
+  kern::ProductView p;
+  p.floats = t.floats.data();
+  p.words = t.words.data();
+  p.tables = t.tables;
+  p.blockLog2 = t.blockLog2;
+  p.plainTexels = t.plainTexels ? 1 : 0;
+  return p;
+}
+
 namespace {
 
 // Pixel p's coefficients of the optimal weights as kernels/sample.cl reads them: all 0
@@ -61,6 +71,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   ts.techniqueCount = M;
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
   ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
+  ts.product = makeProductView(scene_.productTables);
+  ts.productMixture = {};
   const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
   const SampleColumns columns = sampleColumns(scene_, config);
   ts.sharePdfs = columns.shareColumns > 0 ? 1 : 0;
@@ -79,6 +91,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     b.rhoD = p.rhoD;
     b.rhoS = p.rhoS;
     b.n = p.n;
+    kern::TechniqueSet pixelTs = ts;
+    if (ts.product.tables > 0) pixelTs.productMixture = kern::productMixture(ts.product, b);
     const kern::StageCounts c =
         kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
                               config_.estimator == Estimator::OneSample,
@@ -87,8 +101,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + size_t(pixel) * slots;
     for (int j = 0; j < plan.stageSamples; ++j) {
-      kern::SampleContribution s = kern::takeStageSample(ts, pixelEnv, b, c, j, uint32_t(seed), uint32_t(seed >> 32),
-                                                         uint32_t(scene_.firstPixel + pixel));
+      kern::SampleContribution s = kern::takeStageSample(pixelTs, pixelEnv, b, c, j, uint32_t(seed),
+                                                         uint32_t(seed >> 32), uint32_t(scene_.firstPixel + pixel));
       if (config_.optimalWeights) s = kern::withOptimalWeights(s, c, a);
       kern::addContribution(&sums, s);
       for (int slot = 0; slot < slots; ++slot)

@@ -48,12 +48,13 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
       "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
-      "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_LOCAL_SIZE={}",
+      "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_PRODUCT_TABLES={} -DMA_PRODUCT_BLOCK_LOG2={} "
+      "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_LOCAL_SIZE={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent, t.bankShares, t.blockLog2, config.estimator == Estimator::OneSample ? 1 : 0,
       config.estimator == Estimator::CountIndependent ? 1 : 0, config.risCandidates, config.statsMask,
       config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0,
-      localSize);
+      scene.productTables.tables, scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, localSize);
 }
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
@@ -62,6 +63,8 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
   cdfTable = upload(device, t.cdfTable);
   aliasTable = upload(device, t.aliasTable);
   blockProbs = upload(device, t.blockProbs);
+  productFloats = upload(device, scene.productTables.floats);
+  productWords = upload(device, scene.productTables.words);
   std::vector<float> params;
   params.reserve(scene.grid.pixels.size() * 4);
   for (std::size_t p = 0; p < scene.grid.pixels.size(); ++p) {
@@ -79,8 +82,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const LaunchShape shape = chooseLocalSize(
       deviceLimits(device.device),
       [&](int size) {
-        return sampleKernelLocalBytes(size, statSlots(), doubleSums_,
-                                      config.optimalWeights ? 3 * scene.techniqueCount() : 0);
+        return sampleKernelLocalBytes(
+            size, statSlots(), doubleSums_,
+            (config.optimalWeights ? 3 * scene.techniqueCount() : 0) + (scene.productTables.enabled() ? 3 : 0));
       },
       localSize);
   localSize_ = shape.localSize;
@@ -149,11 +153,11 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
     else
       bindKernelArgs(kernel, args...);
   };
-  bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, cl_int(scene_.tables.width), cl_int(scene_.tables.height),
-       b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_,
-       cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
-       cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
-       cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
+  bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, b.productFloats, b.productWords, cl_int(scene_.tables.width),
+       cl_int(scene_.tables.height), b.brdfParams, scene_.mirror[0], scene_.mirror[1], scene_.mirror[2], counts_,
+       firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
+       cl_int(scene_.firstPixel), cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
+       cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
   cl::Event done;
   queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);

@@ -22,7 +22,7 @@ class SceneBuffers {
   SceneBuffers(const Device& device, const Scene& scene);
   cl_context context() const { return context_; }
 
-  cl::Buffer texels, cdfTable, aliasTable, blockProbs, brdfParams;
+  cl::Buffer texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, brdfParams;
 
  private:
   cl_context context_;
@@ -69,7 +69,7 @@ class Sampler : public StageSampler {
   // A stage's per-pixel inputs and outputs, whole-image sized so that a tile writes its rows.
   cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
   cl::Buffer coefficients_;  // --weights optimal: a_{c,k} per pixel (StagePlan::optimalCoefficients)
-  DeviceShare share_;  // since reset()
+  DeviceShare share_;        // since reset()
 };
 
 }  // namespace misalloc

@@ -16,6 +16,7 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> Scene::techniqueNames() const {
   if (options.splitBrdf) return {"envmap", "diffuse", "specular"};
+  if (options.product) return {"envmap", "brdf", "product"};
   return {"envmap", "brdf"};
 }
 
@@ -67,6 +68,10 @@ EnvmapSampler parseEnvmapSampler(const std::string& name) {
 Scene makeScene(const SceneOptions& options) {
   if (!(options.viewTheta >= 0 && options.viewTheta < 90))
     throw InputError(fmt::format("--view {}: the view's polar angle must lie in [0, 90) degrees", options.viewTheta));
+  if (options.product && options.splitBrdf)
+    throw InputError(
+        "--product with --split-brdf: not implemented; the kernels take at most 3 techniques (MA_MAX_TECHNIQUES), "
+        "and the BRDF's lobes split and the product make 4");
   Scene scene;
   scene.options = options;
   scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
@@ -89,12 +94,18 @@ Scene makeScene(const SceneOptions& options) {
       scene.bankCacheKey = bankCacheKey(scene.envmap, options.sampler, scene.grid, scene.mirror);
       cached = readCachedBank(options.bankCacheDir, scene.bankCacheKey, scene.envmap.image);
       // A hit costs its key (every texel hashed) and its read.
-      if (cached) cached->bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (cached)
+        cached->bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
-    scene.tables = cached ? std::move(*cached)
-                          : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
+    scene.tables =
+        cached ? std::move(*cached) : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
+  }
+  if (options.product) {
+    scene.productTables = buildProductTables(scene.envmap, scene.grid, scene.mirror);
+    const EnvmapTables& t = scene.tables;
+    scene.productTables.plainTexels = t.pdf.plain() && !t.hasBank() && !t.useCdf;
   }
   // The tables hold every texel's RGB beside its probability (kernels/envmap.h), so the
   // input copy goes: 12 of the map's bytes per texel. Any other pdf than plain keeps it

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "distributions/EnvmapDistribution.h"
+#include "distributions/ProductTables.h"
 #include "scene/BrdfGrid.h"
 #include "scene/Envmap.h"
 
@@ -15,6 +16,7 @@ struct SceneOptions {
   int width = 128, height = 128;
   double viewTheta = 0, viewPhi = 0;  // ω_o in degrees; the normal is z
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
+  bool product = false;               // M = 3: envmap × BRDF × cos as a third technique (--product)
   EnvmapSampler sampler = EnvmapSampler::Alias;
   EnvmapPdf envmapPdf;  // [Kar19]: plain, or compensated for MIS with BRDF sampling
   int proceduralWidth = 512;
@@ -22,8 +24,9 @@ struct SceneOptions {
   // every time. Not part of the scene: the same tables either way.
   std::string bankCacheDir;
 
-  // M: envmap sampling and BRDF sampling, or the envmap and each of the BRDF's two lobes.
-  int techniqueCount() const { return splitBrdf ? 3 : 2; }
+  // M: envmap sampling and BRDF sampling, then either of the BRDF's lobes split, or the
+  // product technique.
+  int techniqueCount() const { return splitBrdf || product ? 3 : 2; }
 };
 
 // Everything the sampling kernel reads, built once per run.
@@ -32,6 +35,7 @@ struct Scene {
   std::string envmapPath;  // the resolved file, empty for procedural maps
   Envmap envmap;           // its image keeps width and height; the texels live in `tables`
   EnvmapTables tables;
+  ProductTables productTables;  // --product; none otherwise
   BrdfGrid grid;
   std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading

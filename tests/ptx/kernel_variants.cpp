@@ -49,13 +49,14 @@ struct Variant {
   bool operator<(const Variant& other) const { return std::tie(file, options) < std::tie(other.file, other.options); }
 };
 
-Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler, const std::string& pdf) {
+Scene scene(const std::string& envmap, bool split, bool product, EnvmapSampler sampler, const std::string& pdf) {
   SceneOptions o;
   o.envmapPdf = parseEnvmapPdf(pdf);
   o.envmap = envmap;
   o.grid = "uniform:0.5,0.5,10";
   o.width = o.height = 4;
   o.splitBrdf = split;
+  o.product = product;
   o.sampler = sampler;
   o.proceduralWidth = 64;
   return makeScene(o);
@@ -68,15 +69,19 @@ Scene scene(const std::string& envmap, bool split, EnvmapSampler sampler, const 
 // requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank (M = 2
 // only) on one map: the map changes MA_COSK alone. The optimal weights at the CPU's and
 // the largest GPU's work-group only: the size changes the local arrays' lengths alone,
-// and their 100 variants at the other sizes would cost CI about 7 s.
+// and their 100 variants at the other sizes would cost CI about 7 s. The product
+// technique (M = 3 as with split lobes, its tables' count compiled in) on one map, at
+// those two sizes too.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
   for (const std::string pdf : {"plain", "optimal"})
-    for (bool split : {false, true})
+    for (int techniques : {0, 1, 2})  // the BRDF as one technique, split, or with the product
       for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
         for (const std::string envmap : {"constant", "cosk:3"}) {
+          const bool split = techniques == 1, product = techniques == 2;
           if (pdf == "optimal" && (split || envmap != "constant")) continue;
-          Scene s = scene(envmap, split, sampler, pdf);
+          if (product && envmap != "constant") continue;
+          Scene s = scene(envmap, split, product, sampler, pdf);
           for (Method method : allMethods())
             for (Estimator estimator : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent})
               for (MisWeights weights : {MisWeights::Balance, MisWeights::Optimal}) {
@@ -90,7 +95,7 @@ std::set<Variant> hostVariants() {
                 }
                 SamplerConfig config = samplerConfigFor(method, estimator, 64, options);
                 for (int localSize : {8, 64, 128, 256}) {
-                  if (config.optimalWeights && localSize != 8 && localSize != 256) continue;
+                  if ((config.optimalWeights || product) && localSize != 8 && localSize != 256) continue;
                   variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
                   variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
                 }

@@ -1,0 +1,227 @@
+// The product technique (kernels/product.h, host/distributions/ProductTables.h): the
+// texels it draws follow the pdf every MIS weight reads, that pdf integrates to 1 and is
+// positive wherever the map is lit, and estimators that use it are unbiased against
+// [HS14] eq. 6.17 on both samplers and every envmap pdf.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "Constants.h"
+#include "Error.h"
+#include "KernelCode.h"
+#include "SceneFixtures.h"
+#include "Statistics.h"
+#include "TestDevice.h"
+#include "TestSize.h"
+#include "render/Render.h"
+#include "sampling/HostSampler.h"
+#include "sampling/KernelViews.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+constexpr double kFloatRounding = 0x1p-24;
+
+Scene productScene(const std::string& envmap, const std::string& grid, int w, int h, double viewTheta,
+                   const std::string& pdf = "plain", EnvmapSampler sampler = EnvmapSampler::Alias) {
+  return smallScene(envmap, grid, w, h, false, sampler, viewTheta, pdf, true);
+}
+
+kern::PhongParams phongOf(const PhongParameters& p) {
+  kern::PhongParams b;
+  b.rhoD = p.rhoD;
+  b.rhoS = p.rhoS;
+  b.n = p.n;
+  return b;
+}
+
+// Each texel's probability under pixel b's product: the block's ratio to the plain
+// envmap's times the texel's plain probability.
+std::vector<double> productTexelProbabilities(const Scene& scene, const kern::PhongParams& b) {
+  const kern::EnvmapView env = makeEnvmapView(scene.tables, -1);
+  const kern::ProductView view = makeProductView(scene.productTables);
+  const kern::ProductMixture m = kern::productMixture(view, b);
+  const int width = scene.tables.width, height = scene.tables.height, L = view.blockLog2;
+  const float* plain = view.floats + view.tables + view.tables * kern::productBlocks(env, view);
+  std::vector<double> p(std::size_t(width) * height);
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col) {
+      const int block = (row >> L) * kern::productBlocksAcross(env, view) + (col >> L);
+      const std::size_t t = std::size_t(row) * width + col;
+      p[t] = double(kern::productRatio(env, view, m, block)) * plain[t];
+    }
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("the product technique draws texels with the probabilities its pdf reads, which integrate to 1",
+          "[product]") {
+  // A real map, a small sun 10⁵ times the sky, and cos^K; a diffuse, a glossy, a
+  // near-mirror and a black BRDF, seen along the normal and 60° off it. One χ² test per
+  // case; a false alarm in any of them with probability 2 %.
+  const std::vector<std::string> maps = {"venice_sunset", "sun:40,90,0.5,1e5", "cosk:3"};
+  const std::vector<PhongParameters> brdfs = {{0.9f, 0.1f, 2}, {0.2f, 0.8f, 40}, {0.0f, 1.0f, 5000}, {0, 0, 10}};
+  const std::vector<double> views = {0, 60};
+  const double level = sidakLevel(0.02, int(maps.size() * brdfs.size() * views.size()));
+  for (const std::string& map : maps)
+    for (double view : views) {
+      // The grid holds every BRDF, so that every one has its exponent's table.
+      const Scene scene = productScene(map, "seed000", 8, 8, view);
+      Scene withBrdfs = scene;
+      for (std::size_t i = 0; i < brdfs.size(); ++i) withBrdfs.grid.pixels[i] = brdfs[i];
+      // The scene keeps no copy of the map's image with the plain pdf: read it again.
+      const Envmap envmap = makeEnvmap(resolveEnvmapSpec(map), scene.options.proceduralWidth);
+      withBrdfs.productTables = buildProductTables(envmap, withBrdfs.grid, scene.mirror);
+      withBrdfs.productTables.plainTexels = scene.productTables.plainTexels;
+      const kern::EnvmapView env = makeEnvmapView(withBrdfs.tables, -1);
+      const kern::ProductView product = makeProductView(withBrdfs.productTables);
+      REQUIRE(product.tables >= 3);
+      for (std::size_t i = 0; i < brdfs.size(); ++i) {
+        const kern::PhongParams b = phongOf(brdfs[i]);
+        INFO(fmt::format("{} view {} BRDF {},{},{}", map, view, b.rhoD, b.rhoS, b.n));
+        const kern::ProductMixture mixture = kern::productMixture(product, b);
+        const std::vector<double> p = productTexelProbabilities(withBrdfs, b);
+        double sum = 0;
+        for (double v : p) sum += v;
+        // Three tables' block probabilities and a texel's, each rounded to float once, and
+        // the mixture's products and sums: each term within 16 roundings of its own value.
+        CHECK(std::abs(sum - 1) <= 16 * kFloatRounding);
+        // Positive wherever the plain envmap pdf is: unbiased wherever the map is lit.
+        std::size_t uncovered = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) uncovered += withBrdfs.tables.texels[4 * t + 3] > 0 && !(p[t] > 0);
+        CHECK(uncovered == 0);
+
+        // The kernels' sampler with its own random numbers: draw and mixture choice.
+        const uint64_t samples = 200000;
+        std::vector<uint64_t> counts(p.size(), 0);
+        for (uint64_t s = 0; s < samples; ++s) {
+          const kern::MaRandom4 rnd = kern::philoxDraw(0x9d, uint32_t(i), 0, 2, uint32_t(s));
+          const float u = kern::uniformFloat(kern::philoxDrawPart(0x9d, uint32_t(i), 0, 2, uint32_t(s), 1).v[0]);
+          ++counts[kern::sampleProduct(env, product, mixture, rnd, u).texel];
+        }
+        uint64_t zeroDraws = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) zeroDraws += p[t] == 0 ? counts[t] : 0;
+        CHECK(zeroDraws == 0);
+        const ChiSquare test = chiSquare(counts, p, samples);
+        INFO("chi^2 = " << test.statistic << " with " << test.degreesOfFreedom << " degrees of freedom");
+        CHECK(test.pValue() > level);
+
+        // With the plain pdf and the alias sampler, the product scales the envmap's own
+        // pdf (ProductView::plainTexels): the texels' plain probabilities are its own.
+        REQUIRE(withBrdfs.productTables.plainTexels);
+        const float* plain = product.floats + product.tables + product.tables * kern::productBlocks(env, product);
+        std::size_t differ = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) differ += plain[t] != withBrdfs.tables.texels[4 * t + 3];
+        CHECK(differ == 0);
+
+        // The solid-angle pdf a BRDF-sampled direction reads, by the midpoint rule, on
+        // the path that reads the texel's plain probability, as with the other pdfs.
+        kern::ProductView ownTexels = product;
+        ownTexels.plainTexels = 0;
+        const int k = p.size() > 100000 ? 1 : 4;
+        const int nu = k * env.width, nv = k * env.height;
+        double integral = 0;
+        std::size_t pathsDiffer = 0;
+        for (int j = 0; j < nv; ++j) {
+          const double v = (j + 0.5) / nv;
+          const double rowWeight = 2 * kPi * kPi * std::sin(kPi * v) / (double(nu) * nv);
+          for (int c = 0; c < nu; ++c) {
+            const kern::MaVec3 w = kern::latLongDirection(float((c + 0.5) / nu), float(v));
+            const int t = kern::texelOfDirection(env, w);
+            const float sinTheta = std::sqrt(w.x * w.x + w.y * w.y);
+            const float pdf = kern::productPdf(env, ownTexels, mixture, t, 0.0f, sinTheta);
+            pathsDiffer +=
+                pdf != kern::productPdf(env, product, mixture, t, kern::envmapTexelHit(env, t, w).pdf, sinTheta);
+            integral += pdf * rowWeight;
+          }
+        }
+        // And envmapPdfOfTexel's float arithmetic, with sin θ of a float direction.
+        CHECK(std::abs(integral - 1) <= 64 * kFloatRounding);
+        CHECK(pathsDiffer == 0);  // scaling the envmap's pdf is reading the texel's own
+      }
+    }
+}
+
+TEST_CASE("a pixel's product mixture follows its BRDF's lobes", "[product]") {
+  const Scene scene = productScene("venice_sunset", "seed000", 8, 8, 30);
+  const kern::ProductView product = makeProductView(scene.productTables);
+  // A diffuse BRDF takes no specular table, a pure lobe no diffuse one; the plain
+  // envmap keeps its share; a black BRDF takes the plain envmap alone.
+  kern::ProductMixture diffuse = kern::productMixture(product, phongOf({1, 0, 10}));
+  CHECK(diffuse.specular == 0);
+  CHECK(diffuse.diffuse == Approx(1 - MA_PRODUCT_PLAIN_SHARE).epsilon(1e-6));
+  kern::ProductMixture glossy = kern::productMixture(product, phongOf({0, 1, 10}));
+  CHECK(glossy.diffuse == 0);
+  CHECK(glossy.specular == Approx(1 - MA_PRODUCT_PLAIN_SHARE).epsilon(1e-6));
+  kern::ProductMixture black = kern::productMixture(product, phongOf({0, 0, 10}));
+  CHECK(black.diffuse == 0);
+  CHECK(black.specular == 0);
+  // Every exponent finds the table of its own bin when the grid has it.
+  for (const PhongParameters& p : scene.grid.pixels) {
+    const int bin = kern::productExponentBin(p.n);
+    CHECK(int(product.words[bin]) >= MA_PRODUCT_TABLE_DIFFUSE + 1);
+    CHECK(int(product.words[bin]) < product.tables);
+  }
+}
+
+TEST_CASE("estimators with the product technique are unbiased against [HS14] eq. 6.17", "[unbiased][product]") {
+  struct Case {
+    double rhoD, n, K;
+  };
+  const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.05, 1000, 0.5}, {0.7, 0.1, 6}};
+  const std::vector<int> picked = smallTestSize() ? std::vector<int>{0, 2} : std::vector<int>{0, 1, 2, 3};
+  for (int i : picked) {
+    const Case& c = cases[i];
+    uint64_t seed = 900 + uint64_t(64 * i);
+    const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+    for (const std::string pdf : {"plain", "compensated", "optimal"})
+      for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+        // Each case's K and each pdf is a kernel of its own (MA_COSK): the other pdfs on
+        // two BRDFs, multi-sample, keep the PoCL compiles of a fresh CI to a minute.
+        const bool plain = pdf == "plain";
+        if (!plain && i % 2 == 1) continue;
+        const Scene scene = productScene(fmt::format("cosk:{}", c.K),
+                                         fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), 32, 32, 0, pdf, s);
+        REQUIRE(scene.techniqueCount() == 3);
+        // The product alone, the three techniques in equal counts, and one-sample MIS.
+        StagePlan alone = singleStagePlan(scene, Method::Equal, 48);
+        for (int p = 0; p < scene.pixelCount(); ++p) {
+          alone.counts[3 * p] = alone.counts[3 * p + 1] = 0;
+          alone.counts[3 * p + 2] = 48;
+        }
+        const StagePlan equal = singleStagePlan(scene, Method::Equal, 48);
+        struct Run {
+          const char* name;
+          const StagePlan& plan;
+          Estimator estimator;
+        };
+        for (const Run& run :
+             {Run{"product alone", alone, Estimator::MultiSample}, Run{"equal", equal, Estimator::MultiSample},
+              Run{"equal one-sample", equal, Estimator::OneSample}}) {
+          if (!plain && run.estimator == Estimator::OneSample) continue;
+          Sampler sampler(testDevice(), scene, {run.estimator, 0, 0});
+          const MeanAndError r = pixelMean(sampler.run(run.plan, ++seed).rgb);
+          const double z = zScore(r.mean, expected, r.standardError);
+          INFO(fmt::format("rhoD {} n {} K {} pdf {} cdf {} {}: mean {} expected {} z {}", c.rhoD, c.n, c.K, pdf,
+                           s == EnvmapSampler::Cdf, run.name, r.mean, expected, z));
+          CHECK(std::abs(z) < kMaxZ);
+        }
+      }
+  }
+}
+
+TEST_CASE("the product technique with split lobes is refused: 4 techniques", "[product][bad-input]") {
+  SceneOptions o;
+  o.envmap = "constant";
+  o.grid = "uniform:0.5,0.5,10";
+  o.width = o.height = 4;
+  o.splitBrdf = o.product = true;
+  o.envmapPdf = parseEnvmapPdf("plain");
+  CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --split-brdf: not implemented"));
+}
