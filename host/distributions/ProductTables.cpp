@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 
 #include "KernelCode.h"
 #include "distributions/BlockCells.h"
