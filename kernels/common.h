@@ -21,8 +21,14 @@
 #define ma_as_uint(f) as_uint(f)
 typedef uint ma_uint;
 typedef ulong ma_ulong;
-// The 64 bits at 8-byte slot i of a buffer of 32-bit words (the first word low).
+// The 64 bits at 8-byte slot i of a buffer of 32-bit words (the first word low). One
+// 64-bit read halves a lookup's gathers; where a kernel must keep its loop free of 64-bit
+// loads (MA_SPLIT_LOAD64, samplePixelStage: docs/pocl.md, rule 10), two 32-bit reads.
+#if MA_SPLIT_LOAD64
+#define ma_load64(p, i) upsample(((MA_GLOBAL const ma_uint*)(p))[2 * (i) + 1], ((MA_GLOBAL const ma_uint*)(p))[2 * (i)])
+#else
 #define ma_load64(p, i) (((MA_GLOBAL const ma_ulong*)(p))[i])
+#endif
 // Loops left in the sample loop make PoCL split it at implicit barriers: unroll them.
 #define MA_UNROLL _Pragma("unroll")
 #if defined(cl_khr_fp64)

@@ -11,7 +11,8 @@
 // technique's tables, kernels/product.h; 0: none), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
-// weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE.
+// weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE, and for
+// samplePixelStage MA_PIXEL_LANES (0: no such kernel) with MA_SPLIT_LOAD64.
 // Constants fold the unused techniques, sampler, estimator and statistics away.
 //
 // No contraction of a*b + c into fma but where the code says fma: the C++ reference is
@@ -66,6 +67,44 @@ MA_FN ProductView productView(__global const float* productFloats, __global cons
   return p;
 }
 
+// Writes what a pixel's samples share into its rows: row r at pixelRows[r·rowStride + column].
+MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __global const float* brdfParams,
+                         __global const int* counts, __global const uint* firstIndex,
+                         __global const float* coefficients, __global const float* productFloats,
+                         __global const uint* productWords, int stageSamples, int pixel) {
+#define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
+  StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                            MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
+  int rowValues[ROW_COEFFICIENTS] = {as_int(brdfParams[4 * pixel + 0]),
+                                     as_int(brdfParams[4 * pixel + 1]),
+                                     as_int(brdfParams[4 * pixel + 2]),
+                                     as_int(brdfParams[4 * pixel + 3]),
+                                     pixelCounts.n0,
+                                     pixelCounts.n1,
+                                     pixelCounts.n2,
+                                     (int)pixelCounts.first0,
+                                     (int)pixelCounts.first1,
+                                     (int)pixelCounts.first2};
+  MA_UNROLL
+  for (int r = 0; r < ROW_COEFFICIENTS; ++r) PIXEL_ROW(r) = rowValues[r];
+#if MA_OPTIMAL_WEIGHTS
+  MA_UNROLL
+  for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
+    PIXEL_ROW(ROW_COEFFICIENTS + r) = as_int(coefficients[pixel * 3 * MA_TECHNIQUES + r]);
+#endif
+#if MA_PRODUCT_TABLES > 0
+  PhongParams brdf;
+  brdf.rhoD = brdfParams[4 * pixel + 0];
+  brdf.rhoS = brdfParams[4 * pixel + 1];
+  brdf.n = brdfParams[4 * pixel + 2];
+  ProductMixture mixture = productMixture(productView(productFloats, productWords), brdf);
+  PIXEL_ROW(ROW_PRODUCT) = as_int(mixture.diffuse);
+  PIXEL_ROW(ROW_PRODUCT + 1) = as_int(mixture.specular);
+  PIXEL_ROW(ROW_PRODUCT + 2) = mixture.specularTable;
+#endif
+#undef PIXEL_ROW
+}
+
 // Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
 // The envmap tables are read where the sample falls: they are the gathers that remain.
 // The random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
@@ -73,10 +112,10 @@ MA_FN ProductView productView(__global const float* productFloats, __global cons
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs,
                                        __global const float* productFloats, __global const uint* productWords,
-                                       int width, int height, __local const int* pixelRows, int lid, MaVec3 mirror,
-                                       int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
-                                       int technique, int j) {
-#define PIXEL_ROW(row) pixelRows[(row)*MA_LOCAL_SIZE + lid]
+                                       int width, int height, __local const int* pixelRows, int rowStride, int column,
+                                       MaVec3 mirror, int stageSamples, uint seedLo, uint seedHi, int firstPixel,
+                                       int pixel, int technique, int j) {
+#define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   EnvmapView env;
   env.texels = texels;
   env.cdfTable = cdfTable;
@@ -140,18 +179,25 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 #undef PIXEL_ROW
 }
 
-__kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(
-    __global const float* texels, __global const float* cdfTable, __global const uint* aliasTable,
-    __global const float* blockProbs, __global const float* productFloats, __global const uint* productWords, int width,
-    int height, __global const float* brdfParams, float mirrorX, float mirrorY, float mirrorZ,
-    __global const int* counts, __global const uint* firstIndex, int stageSamples, uint seedLo, uint seedHi,
-    int firstPixel, int pixelCount, __global const int* pixelOrder, __global ma_acc* estimate, __global ma_acc* moments,
-    __global ma_acc* stats, __global float* samples, int firstSlot, int sampleCapacity, int spareSamples
+// The arguments of both sampling kernels: the host binds them once (Sampler::runPixels).
+// --weights optimal: coefficients[pixel·3M + c·M + k] is a_{c,k} (kernels/pixel.h).
 #if MA_OPTIMAL_WEIGHTS
-    ,
-    __global const float* coefficients  // [pixel·3M + c·M + k]: a_{c,k} (kernels/pixel.h)
+#define MA_OPTIONAL_PARAMETERS , __global const float* coefficients
+#define MA_COEFFICIENTS coefficients
+#else
+#define MA_OPTIONAL_PARAMETERS
+#define MA_COEFFICIENTS ((__global const float*)0)
 #endif
-) {
+#define MA_SAMPLE_STAGE_PARAMETERS                                                                                  \
+  __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                    \
+      __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,     \
+      int width, int height, __global const float *brdfParams, float mirrorX, float mirrorY, float mirrorZ,         \
+      __global const int *counts, __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi,      \
+      int firstPixel, int pixelCount, __global const int *pixelOrder, __global ma_acc *estimate,                    \
+      __global ma_acc *moments, __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, \
+      int spareSamples MA_OPTIONAL_PARAMETERS
+
+__kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
   __local ma_acc running[STAT_SLOTS > 0 ? STAT_SLOTS : 1][MA_LOCAL_SIZE];
   int gid = (int)get_global_id(0), lid = (int)get_local_id(0);
@@ -162,35 +208,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
-  StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
-                                            MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  int rowValues[ROW_COEFFICIENTS] = {as_int(brdfParams[4 * pixel + 0]),
-                                     as_int(brdfParams[4 * pixel + 1]),
-                                     as_int(brdfParams[4 * pixel + 2]),
-                                     as_int(brdfParams[4 * pixel + 3]),
-                                     pixelCounts.n0,
-                                     pixelCounts.n1,
-                                     pixelCounts.n2,
-                                     (int)pixelCounts.first0,
-                                     (int)pixelCounts.first1,
-                                     (int)pixelCounts.first2};
-  MA_UNROLL
-  for (int r = 0; r < ROW_COEFFICIENTS; ++r) pixelRows[r * MA_LOCAL_SIZE + lid] = rowValues[r];
-#if MA_OPTIMAL_WEIGHTS
-  MA_UNROLL
-  for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
-    pixelRows[(ROW_COEFFICIENTS + r) * MA_LOCAL_SIZE + lid] = as_int(coefficients[pixel * 3 * MA_TECHNIQUES + r]);
-#endif
-#if MA_PRODUCT_TABLES > 0
-  PhongParams brdf;
-  brdf.rhoD = brdfParams[4 * pixel + 0];
-  brdf.rhoS = brdfParams[4 * pixel + 1];
-  brdf.n = brdfParams[4 * pixel + 2];
-  ProductMixture mixture = productMixture(productView(productFloats, productWords), brdf);
-  pixelRows[ROW_PRODUCT * MA_LOCAL_SIZE + lid] = as_int(mixture.diffuse);
-  pixelRows[(ROW_PRODUCT + 1) * MA_LOCAL_SIZE + lid] = as_int(mixture.specular);
-  pixelRows[(ROW_PRODUCT + 2) * MA_LOCAL_SIZE + lid] = mixture.specularTable;
-#endif
+  loadPixelRows(pixelRows, MA_LOCAL_SIZE, lid, brdfParams, counts, firstIndex, MA_COEFFICIENTS, productFloats,
+                productWords, stageSamples, pixel);
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
   // sampler only. A work-group runs its largest n_k; the other work-items' surplus
@@ -208,8 +227,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
       SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width,
-                                           height, pixelRows, lid, makeVec3(mirrorX, mirrorY, mirrorZ), stageSamples,
-                                           seedLo, seedHi, firstPixel, pixel, k, jk);
+                                           height, pixelRows, MA_LOCAL_SIZE, lid, makeVec3(mirrorX, mirrorY, mirrorZ),
+                                           stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;
@@ -259,3 +278,81 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int s = 0; s < STAT_SLOTS; ++s) stats[pixel * STAT_SLOTS + s] = running[s][lid];
   }
 }
+
+#if MA_PIXEL_LANES > 0 && MA_STATS == 0 && !MA_STORE_SAMPLES
+// The same stage on a CPU, one work-group of MA_PIXEL_LANES (the float vector width)
+// per pixel: lane l takes samples l, L + l, 2L + l, ... of each technique, so that PoCL
+// vectorises across a pixel's samples. Nothing 64-bit is loaded, stored or carried in
+// the sample loop, which would cap LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10):
+// each sample's terms go to local memory in float, and lane 0 adds a chunk of them in
+// the C++ reference's order (addContribution), which keeps the sums bit for bit its sums.
+// Statistics and stored samples stay with sampleStage.
+#define PASSES_PER_CHUNK 8
+#define CHUNK_SAMPLES (PASSES_PER_CHUNK * MA_PIXEL_LANES)
+enum { TERM_R, TERM_G, TERM_B, TERM_W, TERM_TECHNIQUE, TERM_COUNT };
+
+// Adds terms [0, count) of a chunk of technique k's samples (one-sample: each term's own).
+MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, int count, int k) {
+  PixelSums sums = *pixelSums;
+  for (int t = 0; t < count; ++t) {
+    SampleContribution s;
+    s.r = terms[TERM_R * CHUNK_SAMPLES + t];
+    s.g = terms[TERM_G * CHUNK_SAMPLES + t];
+    s.b = terms[TERM_B * CHUNK_SAMPLES + t];
+    s.w = terms[TERM_W * CHUNK_SAMPLES + t];
+    s.technique = MA_ONE_SAMPLE ? as_int(terms[TERM_TECHNIQUE * CHUNK_SAMPLES + t]) : k;
+    addContribution(&sums, s);
+  }
+  *pixelSums = sums;
+}
+
+__kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void samplePixelStage(MA_SAMPLE_STAGE_PARAMETERS) {
+  __local int pixelRows[ROW_COUNT];
+  __local float terms[TERM_COUNT * CHUNK_SAMPLES];
+  __local PixelSums pixelSums;
+  int lid = (int)get_local_id(0);
+  int pixel = pixelOrder[get_group_id(0)];
+  if (lid == 0) {
+    loadPixelRows(pixelRows, 1, 0, brdfParams, counts, firstIndex, MA_COEFFICIENTS, productFloats, productWords,
+                  stageSamples, pixel);
+    pixelSums = zeroPixelSums();
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  MA_UNROLL
+  for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
+    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[ROW_N0 + k];
+    for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
+      int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
+      for (int p = 0; p < passes; ++p) {
+        // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
+        int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
+        SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
+                                             width, height, pixelRows, 1, 0, makeVec3(mirrorX, mirrorY, mirrorZ),
+                                             stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+        terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
+        terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
+        terms[TERM_B * CHUNK_SAMPLES + t] = c.b;
+        terms[TERM_W * CHUNK_SAMPLES + t] = c.w;
+        if (MA_ONE_SAMPLE) terms[TERM_TECHNIQUE * CHUNK_SAMPLES + t] = as_float(c.technique);
+        barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across samples
+      }
+      if (lid == 0) addChunk(&pixelSums, terms, min(CHUNK_SAMPLES, n - chunk), k);
+      barrier(CLK_LOCAL_MEM_FENCE);
+    }
+  }
+  if (lid == 0) {
+    estimate[3 * pixel + 0] = pixelSums.r;
+    estimate[3 * pixel + 1] = pixelSums.g;
+    estimate[3 * pixel + 2] = pixelSums.b;
+    __global ma_acc* m = moments + pixel * MA_TECHNIQUES * 2;
+    m[0] = pixelSums.w0;
+    m[1] = pixelSums.ww0;
+    m[2] = pixelSums.w1;
+    m[3] = pixelSums.ww1;
+    if (MA_TECHNIQUES > 2) {
+      m[4] = pixelSums.w2;
+      m[5] = pixelSums.ww2;
+    }
+  }
+}
+#endif

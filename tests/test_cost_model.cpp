@@ -50,6 +50,17 @@ TEST_CASE("a launch's work is each work-group's largest count per technique", "[
         std::vector<double>{2 * 2 + 2 * 4, 2 * 3 + 2 * 0});
 }
 
+TEST_CASE("one pixel per work-group runs each count rounded up to the lanes", "[costmodel]") {
+  // Lanes of 4: 9 → 12, 7 → 8, 0 → 0, 16 → 16; the group size does not matter.
+  const StagePlan plan = planOf({{9, 7}, {0, 16}});
+  CHECK(launchWork(plan, Estimator::MultiSample, 8, 4).slots == std::vector<double>{12 + 0, 8 + 16});
+  // One-sample: N = 16 is a whole pass of lanes, shared by the counts' expectation;
+  // N = 5 rounds up to 8.
+  CHECK(launchWork(plan, Estimator::OneSample, 8, 4).slots == std::vector<double>{9, 23});
+  CHECK(launchWork(planOf({{3, 2}, {1, 4}}), Estimator::OneSample, 8, 4).slots ==
+        std::vector<double>{8.0 * 3 / 5 + 8.0 * 1 / 5, 8.0 * 2 / 5 + 8.0 * 4 / 5});
+}
+
 TEST_CASE("the cost model recovers the costs of a synthetic timing table", "[costmodel]") {
   const double t0 = 2e-3;
   const std::vector<double> c{7.5e-8, 2.5e-8, 4e-8};

@@ -28,7 +28,7 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 // same floats in the same order: equal bit for bit, with the product technique too. The optimal pdf's bank (M = 2 only)
 // is read through every BRDF bin of the grid and, as the counts vary, every share. The
 // optimal weights ([Kon19]) run with coefficients of both signs that differ per pixel.
-TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler]") {
+TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bit for bit", "[sampler]") {
   SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
   shareColumns.shareColumns = true;  // with the optimal pdf
   SamplerConfig optimalWeights{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_OPTIMAL, 100};
@@ -70,11 +70,20 @@ TEST_CASE("sampleStage on PoCL matches its C++ reference bit for bit", "[sampler
           Sampler device(testDevice(), scene, config);
           HostSampler host(scene, config);
           size_t mismatches = 0;
-          // Two stages, so that the running sums and stored samples carry over.
-          for (int stage = 0; stage < 2; ++stage) {
-            plan.samplesBefore = 50 * stage;
-            for (size_t i = 0; i < plan.firstIndex.size(); ++i) plan.firstIndex[i] = uint32_t(plan.counts[i] * stage);
-            StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+          // Two stages, so that the running sums and stored samples carry over, and a last
+          // stage without them (samplePixelStage on a CPU) whose counts span several of
+          // its chunks of terms.
+          for (int stage = 0; stage < 3; ++stage) {
+            const int scale = stage == 2 ? 3 : 1;
+            StagePlan s = plan;
+            s.keepStatistics = stage < 2;
+            s.stageSamples = 50 * scale;
+            s.samplesBefore = 50 * stage;
+            for (size_t i = 0; i < plan.counts.size(); ++i) {
+              s.counts[i] = plan.counts[i] * scale;
+              s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
+            }
+            StageResult a = device.run(s, 42), b = host.run(s, 42);
             for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
             for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
           }

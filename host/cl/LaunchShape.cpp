@@ -59,6 +59,12 @@ DeviceLimits deviceLimits(const cl::Device& device) {
   limits.maxWorkGroupSize = device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
   limits.localMemBytes = device.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
   if ((type & CL_DEVICE_TYPE_GPU) != 0) limits.preferredMultiple = vendorLockstepWidth(device).value_or(32);
+  if (limits.cpu) {
+    const int width =
+        int(std::min<size_t>(device.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>(), limits.maxWorkGroupSize));
+    limits.pixelLanes = 1;
+    while (limits.pixelLanes * 2 <= width) limits.pixelLanes *= 2;
+  }
   return limits;
 }
 

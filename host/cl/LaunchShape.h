@@ -18,6 +18,10 @@ struct DeviceLimits {
   // Work-items that run in lockstep (a warp, a wavefront): a work-group of a multiple of
   // it leaves no lane idle. 1 where it does not matter (CPU).
   size_t preferredMultiple = 1;
+  // CPU: its native float vector width (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), rounded
+  // down to a power of two: the lanes of samplePixelStage, one pixel per work-group.
+  // 0 on other devices, which run sampleStage for every stage.
+  int pixelLanes = 0;
 };
 
 // A GPU's preferred multiple is its warp (cl_nv_device_attribute_query) or wavefront

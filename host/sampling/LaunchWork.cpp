@@ -21,10 +21,22 @@ std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range)
   return order;
 }
 
-LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize) {
+LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize, int pixelLanes) {
   const int M = plan.techniqueCount;
   const int pixels = int(plan.counts.size() / size_t(M));
   LaunchWork work{plan.keepStatistics, std::vector<double>(M, 0.0)};
+  if (pixelLanes > 0) {
+    auto roundedUp = [&](int n) { return double((n + pixelLanes - 1) / pixelLanes * pixelLanes); };
+    const bool oneSample = estimator == Estimator::OneSample;
+    for (int p = 0; p < pixels; ++p)
+      for (int k = 0; k < M; ++k) {
+        const int n = plan.counts[size_t(p) * M + k];
+        work.slots[k] += oneSample
+                             ? (plan.stageSamples > 0 ? roundedUp(plan.stageSamples) * n / plan.stageSamples : 0.0)
+                             : roundedUp(n);
+      }
+    return work;
+  }
   if (estimator == Estimator::OneSample || groupSize <= 1) {
     for (int p = 0; p < pixels; ++p)
       for (int k = 0; k < M; ++k) work.slots[k] += plan.counts[size_t(p) * M + k];

@@ -42,19 +42,20 @@ std::vector<float> withSpareRecord(std::vector<float> samples, const Scene& scen
 
 }  // namespace
 
-std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize) {
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes) {
   const EnvmapTables& t = scene.tables;
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
       "-DMA_CDF_STEPS_COL={} -DMA_COSK=((float)({:.9g})) -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
       "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_PRODUCT_TABLES={} -DMA_PRODUCT_BLOCK_LOG2={} "
-      "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_LOCAL_SIZE={}",
+      "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} -DMA_SPLIT_LOAD64={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent, t.bankShares, t.blockLog2, config.estimator == Estimator::OneSample ? 1 : 0,
       config.estimator == Estimator::CountIndependent ? 1 : 0, config.risCandidates, config.statsMask,
       config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0,
-      scene.productTables.tables, scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, localSize);
+      scene.productTables.tables, scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, localSize,
+      pixelLanes, pixelLanes > 0 ? 1 : 0);
 }
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
@@ -79,8 +80,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
     : StageSampler(scene, config), device_(device) {
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
   // Both kernels run at one size: that of the one with the running sums, the larger.
+  const DeviceLimits limits = deviceLimits(device.device);
   const LaunchShape shape = chooseLocalSize(
-      deviceLimits(device.device),
+      limits,
       [&](int size) {
         return sampleKernelLocalBytes(
             size, statSlots(), doubleSums_,
@@ -88,14 +90,19 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       },
       localSize);
   localSize_ = shape.localSize;
+  // Measured on haswell (docs/results.md, "One pixel per work-group on a CPU"): the CDF
+  // sampler's searches and resampling's candidates ran slower one pixel per work-group.
+  pixelLanes_ = scene.tables.useCdf || config.risCandidates > 0 ? 0 : limits.pixelLanes;
   share_.launch = shape.why;
+  if (pixelLanes_ > 0)
+    share_.launch += fmt::format("; stages without running sums: one pixel per {} lanes", pixelLanes_);
+  const cl::Program plain =
+      buildProgram(device, "sample.cl", sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_));
+  plainKernel_ = cl::Kernel(plain, pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
   kernel_ =
-      cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize_)), "sampleStage");
-  plainKernel_ =
       keepsStatistics(config)
-          ? cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, plainConfig(config), localSize_)),
-                       "sampleStage")
-          : kernel_;
+          ? cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize_)), "sampleStage")
+          : plainKernel_;
   if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
   if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
   sceneBuffers_ = std::move(sceneBuffers);
@@ -143,7 +150,8 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
                            plan.firstIndex.data() + firstRow);
   const std::vector<int32_t> order = coherentPixelOrder(plan, range);
   queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
-  cl::Kernel& kernel = plan.keepStatistics ? kernel_ : plainKernel_;
+  const bool statistics = plan.keepStatistics && keepsStatistics(config_);
+  cl::Kernel& kernel = statistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
   if (config_.optimalWeights) writeCoefficients(plan, range);
   // The optimal weights' coefficients are an argument of their kernels only.
@@ -158,9 +166,11 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
        firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
        cl_int(scene_.firstPixel), cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
        cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
-  size_t global = (size_t(range.size()) + localSize_ - 1) / localSize_ * localSize_;
+  const int lanes = pixelLanes(statistics);
+  const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
+  const size_t global = lanes > 0 ? size_t(range.size()) * lanes : (size_t(range.size()) + local - 1) / local * local;
   cl::Event done;
-  queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(localSize_), nullptr, &done);
+  queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &done);
   done.wait();
   result.kernelSeconds = eventSeconds(done);
   auto read = [&](const cl::Buffer& b, size_t first, size_t n) {

@@ -11,8 +11,9 @@
 namespace misalloc {
 
 // The `-D` options that compile kernels/sample.cl for exactly this scene, estimator,
-// statistics and work-group size.
-std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize);
+// statistics and work-group size; `pixelLanes` > 0 adds samplePixelStage at that many
+// lanes, with 64-bit table reads split in two (docs/pocl.md, rule 10).
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes = 0);
 
 // A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
 // that share a context (the sub-devices of one device, cl/Device.h) share one copy, so
@@ -28,8 +29,10 @@ class SceneBuffers {
   cl_context context_;
 };
 
-// Runs kernels/sample.cl (sampleStage) on a device. The program is built and the
-// scene uploaded once; each run() takes one stage for every pixel.
+// Runs kernels/sample.cl on a device: sampleStage, across pixels; on a CPU, stages
+// without running sums run samplePixelStage, one pixel per work-group of its native
+// float width. The program is built and the scene uploaded once; each run() takes one
+// stage for every pixel.
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
@@ -51,6 +54,7 @@ class Sampler : public StageSampler {
 
   std::vector<DeviceShare> deviceShares() const override;
   int launchGroupSize() const override { return localSize_; }
+  int pixelLanes(bool keepsStatistics) const override { return keepsStatistics ? 0 : pixelLanes_; }
 
  protected:
   void forgetStages() override;
@@ -62,6 +66,7 @@ class Sampler : public StageSampler {
 
   const Device& device_;
   int localSize_;
+  int pixelLanes_;  // > 0: plainKernel_ is samplePixelStage
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
   std::shared_ptr<const SceneBuffers> sceneBuffers_;

@@ -13,9 +13,10 @@ StageResult StageSampler::run(const StagePlan& plan, uint64_t seed) {
 }
 
 LaunchWork StageSampler::launchWork(const StagePlan& plan) const {
-  LaunchWork work = misalloc::launchWork(plan, config_.estimator, launchGroupSize());
   // A sampler that keeps no statistics runs its one kernel whatever the plan says.
-  work.keepsStatistics = work.keepsStatistics && keepsStatistics(config_);
+  const bool statistics = plan.keepStatistics && keepsStatistics(config_);
+  LaunchWork work = misalloc::launchWork(plan, config_.estimator, launchGroupSize(), pixelLanes(statistics));
+  work.keepsStatistics = statistics;
   return work;
 }
 

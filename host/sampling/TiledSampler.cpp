@@ -179,6 +179,13 @@ int TiledSampler::launchGroupSize() const {
   return largest;
 }
 
+// Devices of different lanes (a CPU beside a GPU) are modelled by the widest.
+int TiledSampler::pixelLanes(bool keepsStatistics) const {
+  int widest = 0;
+  for (const auto& member : members_) widest = std::max(widest, member->pixelLanes(keepsStatistics));
+  return widest;
+}
+
 void TiledSampler::forgetStages() {
   for (size_t d = 0; d < members_.size(); ++d)
     if (live(d)) members_[d]->reset();

@@ -42,6 +42,7 @@ class TiledSampler : public StageSampler {
   double imbalanceSeconds() const override { return imbalanceSeconds_; }
   // Tiles run on every member at once: work-groups taken as large as the largest.
   int launchGroupSize() const override;
+  int pixelLanes(bool keepsStatistics) const override;
 
  private:
   void forgetStages() override;
