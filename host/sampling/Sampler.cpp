@@ -79,7 +79,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
                  std::shared_ptr<const SceneBuffers> sceneBuffers)
     : StageSampler(scene, config), device_(device) {
   doubleSums_ = device.device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
-  // Both kernels run at one size: that of the one with the running sums, the larger.
+  // sampleStage runs at one size with and without running sums: that of the larger.
   const DeviceLimits limits = deviceLimits(device.device);
   const LaunchShape shape = chooseLocalSize(
       limits,
