@@ -31,8 +31,12 @@ typedef struct {
   int texel;  // techniques that draw a texel (drawsTexel): the envmap texel it drew wi in
 } TechniqueSample;
 
+MA_FN int isProductTechnique(TechniqueSet ts, int technique) {
+  return ts.product.tables > 0 && technique == MA_TECHNIQUE_PRODUCT;
+}
+
 MA_FN int drawsTexel(TechniqueSet ts, int technique) {
-  return technique == MA_TECHNIQUE_ENVMAP || (ts.product.tables > 0 && technique == MA_TECHNIQUE_PRODUCT);
+  return technique == MA_TECHNIQUE_ENVMAP || isProductTechnique(ts, technique);
 }
 
 // mixtureU: the product technique's choice of table (sampleProduct); unused by the others.
@@ -56,15 +60,14 @@ MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongPara
 }
 
 // p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i, which
-// lies in texel t.
-MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi, int t, float envmapPdf, float lobe,
-                         float* pdfs) {
+// lies in texel t at sin θ = sinTheta.
+MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi, int t, float sinTheta,
+                         float envmapPdf, float lobe, float* pdfs) {
   pdfs[0] = envmapPdf;
   pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, lobe);
-  pdfs[2] = ts.splitBrdf ? specularPdf(b, lobe)
-                         : (ts.product.tables > 0 ? productPdf(env, ts.product, ts.productMixture, t, envmapPdf,
-                                                               ma_sqrt(wi.x * wi.x + wi.y * wi.y))
-                                                  : 0.0f);
+  pdfs[2] = ts.splitBrdf            ? specularPdf(b, lobe)
+            : ts.product.tables > 0 ? productPdf(env, ts.product, ts.productMixture, t, envmapPdf, sinTheta)
+                                    : 0.0f;
 }
 
 // [HS14] eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.
@@ -89,17 +92,17 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b,
   MaVec3 wi = sample.wi;
   int texel = drawsTexel(ts, technique) ? sample.texel : texelOfDirection(env, wi);
   EnvmapHit hit = envmapTexelHit(env, texel, wi);
-  float cosTheta = ma_max(wi.z, 0.0f);
+  float cosTheta = ma_max(wi.z, 0.0f), sinTheta = ma_sqrt(wi.x * wi.x + wi.y * wi.y);
   float lobe = phongLobe(b, wi, ts.mirror);
   float brdfCos = phongBrdf(b, lobe) * cosTheta;
   SampleValue s;
   s.r = hit.r * brdfCos;
   s.g = hit.g * brdfCos;
   s.b = hit.b * brdfCos;
-  techniquePdfs(ts, env, b, wi, texel, hit.pdf, lobe, s.pdfs);
+  techniquePdfs(ts, env, b, wi, texel, sinTheta, hit.pdf, lobe, s.pdfs);
   MA_UNROLL
   for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
-  if (ts.sharePdfs) bankSharePdfs(env, texel, ma_sqrt(wi.x * wi.x + wi.y * wi.y), s.sharePdfs);
+  if (ts.sharePdfs) bankSharePdfs(env, texel, sinTheta, s.sharePdfs);
   return s;
 }
 

@@ -87,8 +87,8 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float N = (float)c.stageSamples;
   float alpha[MA_MAX_TECHNIQUES];
   stageFractions(c, alpha);
-  if (env.bankShares > 0)
-    env.bankEntry = bankEntryOf(env, bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]));
+  float bankFraction = bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]);
+  if (env.bankShares > 0) env.bankEntry = bankEntryOf(env, bankFraction);
   SampleValue s;
   float invP, scale;
   if (technique == MA_TECHNIQUE_ENVMAP && c.risCandidates > 0) {
@@ -100,7 +100,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   } else {
     MaRandom4 rnd = philoxDraw(seedLo, seedHi, pixel, (ma_uint)technique, index);
     // The product technique's choice of table takes a word of the draw's next part.
-    float mixtureU = drawsTexel(ts, technique) && technique != MA_TECHNIQUE_ENVMAP
+    float mixtureU = isProductTechnique(ts, technique)
                          ? uniformFloat(philoxDrawPart(seedLo, seedHi, pixel, (ma_uint)technique, index, 1u).v[0])
                          : 0.0f;
     s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd, mixtureU));
@@ -117,9 +117,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   }
   SampleContribution out;
   out.technique = technique;
-  out.share = env.bankShares > 0
-                  ? bankShareOf(env.bankShares, bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]))
-                  : 0;
+  out.share = env.bankShares > 0 ? bankShareOf(env.bankShares, bankFraction) : 0;
   out.r = s.r * invP / scale;
   out.g = s.g * invP / scale;
   out.b = s.b * invP / scale;

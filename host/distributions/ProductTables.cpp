@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 
 #include "KernelCode.h"
 #include "distributions/BlockCells.h"
@@ -78,19 +79,16 @@ ProductTables buildProductTables(const Envmap& envmap, const BrdfGrid& grid, con
   t.floats.assign(t.tables + t.tables * blocks + texels, 0.0f);
   t.words.assign(binWords + 2 * t.tables * blocks + 2 * blocks * slots, 0u);
   for (int bin = 0; bin < MA_PRODUCT_EXPONENT_BINS; ++bin) t.words[bin] = uint32_t(exponents.tableOfBin[bin]);
-  double plainTotal = 0;
-  for (double w : weights) plainTotal += w;
+  const double plainTotal = std::accumulate(weights.begin(), weights.end(), 0.0);
   for (int table = 0; table < t.tables; ++table) {
     std::vector<double> w = tableWeights[table];
-    double total = 0;
-    for (double v : w) total += v;
+    double total = std::accumulate(w.begin(), w.end(), 0.0);
     t.floats[table] = float(total);
     // A lobe that sees no light has weight 0 in every mixture (productMixture): its
     // table only has to stay valid. The plain mass is positive (plainTexelWeights).
     if (!(total > 0)) {
       w = cells.plainBlockMass;
-      total = 0;
-      for (double v : w) total += v;
+      total = std::accumulate(w.begin(), w.end(), 0.0);
     }
     float* ratios = t.floats.data() + t.tables + table * blocks;
     for (std::size_t b = 0; b < blocks; ++b) {
