@@ -11,20 +11,28 @@
 #define MA_LOG2E 1.44269504088896340736f
 
 // log2(x) for finite x > 0: exponent plus an atanh series for the mantissa in
-// [√½, √2), |t| ≤ 0.1716, so five terms reach float precision.
-MA_FN float fastLog2(float x) {
-  ma_uint bits = ma_as_uint(x);
-  int e = (int)((bits >> 23) & 0xffu) - 127;
-  float m = ma_as_float((bits & 0x7fffffu) | 0x3f800000u);
-  int big = m > 1.41421356f;
-  m = big ? 0.5f * m : m;
-  e += big;
-  float t = (m - 1.0f) / (m + 1.0f);
-  float t2 = t * t;
-  float series =
-      ma_fma(t2, ma_fma(t2, ma_fma(t2, ma_fma(t2, 1.0f / 9.0f, 1.0f / 7.0f), 1.0f / 5.0f), 1.0f / 3.0f), 1.0f);
-  return (float)e + 2.0f * MA_LOG2E * t * series;
-}
+// [√½, √2), |t| ≤ 0.1716, so five terms reach float precision. Defined for F = float
+// and, in the kernels, float16 (the grid search's entropy rule), lane for lane the same.
+#define MA_DEFINE_FAST_LOG2(name, F, U, I, asUint, asFloat, toInt, toFloat)                                         \
+  MA_FN F name(F x) {                                                                                               \
+    U bits = asUint(x);                                                                                             \
+    I e = toInt((bits >> 23) & 0xffu) - 127;                                                                        \
+    F m = asFloat((bits & 0x7fffffu) | 0x3f800000u);                                                                \
+    I big = m > 1.41421356f ? (I)1 : (I)0;                                                                          \
+    m = m > 1.41421356f ? 0.5f * m : m;                                                                             \
+    e += big;                                                                                                       \
+    F t = (m - 1.0f) / (m + 1.0f);                                                                                  \
+    F t2 = t * t;                                                                                                   \
+    F series = ma_fma(                                                                                              \
+        t2,                                                                                                         \
+        ma_fma(t2, ma_fma(t2, ma_fma(t2, (F)(1.0f / 9.0f), (F)(1.0f / 7.0f)), (F)(1.0f / 5.0f)), (F)(1.0f / 3.0f)), \
+        (F)1.0f);                                                                                                   \
+    return toFloat(e) + 2.0f * MA_LOG2E * t * series;                                                               \
+  }
+MA_DEFINE_FAST_LOG2(fastLog2, float, ma_uint, int, ma_as_uint, ma_as_float, (int), (float))
+#ifdef __OPENCL_VERSION__
+MA_DEFINE_FAST_LOG2(fastLog2x16, float16, uint16, int16, as_uint16, as_float16, convert_int16, convert_float16)
+#endif
 
 // 2^y: integer part into the exponent, fraction by a degree-7 Taylor series of
 // e^g about the middle of [0, 1), |g| ≤ ln2/2. Underflows to 0 below 2^-126.
@@ -67,19 +75,20 @@ MA_FN float fastLog1p(float x) {
 // < 3e-10 relative), fastExp2 − 1 elsewhere, where no cancellation occurs. A select.
 MA_FN float fastExpm1(float x) {
   float series =
-      x * ma_fma(x,
+      x *
+      ma_fma(
+          x,
+          ma_fma(x,
                  ma_fma(x,
                         ma_fma(x,
                                ma_fma(x,
-                                      ma_fma(x,
-                                             ma_fma(x, ma_fma(x, ma_fma(x, 1.0f / 362880.0f, 1.0f / 40320.0f),
-                                                              1.0f / 5040.0f),
-                                                    1.0f / 720.0f),
-                                             1.0f / 120.0f),
-                                      1.0f / 24.0f),
-                               1.0f / 6.0f),
-                        0.5f),
-                 1.0f);
+                                      ma_fma(x, ma_fma(x, ma_fma(x, 1.0f / 362880.0f, 1.0f / 40320.0f), 1.0f / 5040.0f),
+                                             1.0f / 720.0f),
+                                      1.0f / 120.0f),
+                               1.0f / 24.0f),
+                        1.0f / 6.0f),
+                 0.5f),
+          1.0f);
   float direct = fastExp2(x * MA_LOG2E) - 1.0f;
   return ma_abs(x) < 0.5f ? series : direct;
 }

@@ -187,8 +187,7 @@ MA_FN void storeSums(__global float* sums, int j, int l0, int paddedSize, const 
 // sums; P has no scale: it is read as it is, or as 0 where there are no sums yet.
 MA_FN void loadPair(__global const float* sums, int pair, int l0, int paddedSize, float rescale, float16* sumP) {
   for (int v = 0; v < MA_GRID_VECTORS; ++v)
-    sumP[v] = rescale == 0.0f ? (float16)0.0f
-                              : vload16(v, sums + pairSumIndex(pair, l0, MA_TECHNIQUES, paddedSize));
+    sumP[v] = rescale == 0.0f ? (float16)0.0f : vload16(v, sums + pairSumIndex(pair, l0, MA_TECHNIQUES, paddedSize));
 }
 
 MA_FN void storePair(__global float* sums, int pair, int l0, int paddedSize, const float16* sumP) {
@@ -200,8 +199,7 @@ MA_FN void storePair(__global float* sums, int pair, int l0, int paddedSize, con
 // (summarised in `added`) to its running sums at `sums`, which it stores back if
 // `keepSums` (a search follows that adds to them), and, if `rank`, returns the
 // best l₀ by the sums of all its samples (summarised in `all`), or −1 if no
-// combination could be ranked. Rule (b) scores 16 combinations per float16; rule (a)
-// takes its logarithms one combination at a time.
+// combination could be ranked. Both rules score 16 combinations per float16.
 MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelSummary all, float rescale,
                       __global float* sums, int keepSums, int rank, __global const float* gridLanes,
                       __global const float* gridCost, int gridSize, int paddedSize, const float* cost, int rule,
@@ -227,8 +225,7 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
         sumTechnique(prepared + preparedFirst(added, j, MA_EVERY_SAMPLE) * (MA_TECHNIQUES + 1),
                      preparedCount(added, j, MA_EVERY_SAMPLE), alpha, sumG[j], sumG2[j]);
     } else {
-      sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES, MA_EVERY_SAMPLE), alpha, stageMix, sumG, sumG2[0],
-                 sumP);
+      sumMixture(prepared, preparedFirst(added, MA_TECHNIQUES, MA_EVERY_SAMPLE), alpha, stageMix, sumG, sumG2[0], sumP);
     }
     if (keepSums) {
       for (int j = 0; j < MA_TECHNIQUES; ++j) storeSums(sums, j, l0, paddedSize, sumG[j], sumG2[j]);
@@ -246,22 +243,7 @@ MA_FN int searchPixel(__global const float* prepared, PixelSummary added, PixelS
       int16 index = l0 + 16 * v + lanes;
       float16 score;
       if (rule == MA_RULE_MAX_ENTROPY) {
-        float a[16][MA_TECHNIQUES], s1[MA_TECHNIQUES][16], s2[MA_TECHNIQUES][16], h[16];
-        for (int j = 0; j < MA_TECHNIQUES; ++j) {
-          vstore16(g1[j], 0, s1[j]);
-          vstore16(g2[j], 0, s2[j]);
-        }
-        for (int lane = 0; lane < 16; ++lane) {
-          float sumLane[MA_TECHNIQUES], sum2Lane[MA_TECHNIQUES];
-          for (int j = 0; j < MA_TECHNIQUES; ++j) {
-            a[lane][j] = gridLanes[j * paddedSize + l0 + 16 * v + lane];
-            sumLane[j] = s1[j][lane];
-            sum2Lane[j] = s2[j][lane];
-          }
-          h[lane] =
-              entropyScore(MA_TECHNIQUES, a[lane], gridCost[l0 + 16 * v + lane], cost, sumLane, sum2Lane, invCount);
-        }
-        score = vload16(0, h);
+        score = entropyScore16(MA_TECHNIQUES, alpha[v], vload16(0, gridCost + l0 + 16 * v), cost, g1, g2, invCount);
       } else {
 #if MA_GRID_OPTIMAL_WEIGHTS
         float16 p[MA_PAIR_COUNT];
@@ -303,7 +285,8 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
   PixelSummary added[16];
   for (int lane = 0; lane < 16; ++lane) added[lane] = emptySummary();
   for (int i = 0; i < taken; ++i)
-    for (int lane = 0; lane < 16; ++lane) summariseSample(&added[lane], blockSamples + lane, MA_TECHNIQUES, MA_SHARE_COLUMNS, i);
+    for (int lane = 0; lane < 16; ++lane)
+      summariseSample(&added[lane], blockSamples + lane, MA_TECHNIQUES, MA_SHARE_COLUMNS, i);
   PixelSummary all[16];
   uint fallbacks[16];
   int next[16][MA_TECHNIQUES];

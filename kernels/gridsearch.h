@@ -327,28 +327,33 @@ MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix)
 // is the same for every j at the optimum. Score: the entropy of λ_j = Λ_j / Σ_j Λ_j.
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.
-MA_FN float entropyScore(int techniqueCount, const float* alpha, float meanCost, const float* cost, const float* sumG,
-                         const float* sumG2, const float* invCount) {
-  float mu = 0.0f, secondMoment = 0.0f;
-  for (int j = 0; j < techniqueCount; ++j) {
-    mu = ma_fma(alpha[j], sumG[j] * invCount[j], mu);
-    secondMoment = ma_fma(alpha[j], sumG2[j] * invCount[j], secondMoment);
+// Defined for T = float and, in the kernel, T = float16 (16 combinations at once).
+#define MA_DEFINE_ENTROPY_SCORE(name, T, log2)                                                                   \
+  MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const float* cost, const T* sumG, const T* sumG2, \
+               const float* invCount) {                                                                          \
+    T mu = 0.0f, secondMoment = 0.0f;                                                                            \
+    for (int j = 0; j < techniqueCount; ++j) {                                                                   \
+      mu = ma_fma(alpha[j], sumG[j] * invCount[j], mu);                                                          \
+      secondMoment = ma_fma(alpha[j], sumG2[j] * invCount[j], secondMoment);                                     \
+    }                                                                                                            \
+    T variance = ma_max(ma_fma(-mu, mu, secondMoment), 0.0f);                                                    \
+    T Lambda[MA_GRID_MAX_TECHNIQUES], total = 0.0f;                                                              \
+    for (int j = 0; j < techniqueCount; ++j) {                                                                   \
+      Lambda[j] = ma_fma((T)cost[j], variance, -meanCost * (sumG2[j] * invCount[j]));                            \
+      total += Lambda[j];                                                                                        \
+    }                                                                                                            \
+    T entropy = 0.0f, distribution = 1.0f;                                                                       \
+    for (int j = 0; j < techniqueCount; ++j) {                                                                   \
+      T lambda = Lambda[j] / total;                                                                              \
+      distribution = lambda > 0.0f ? distribution : 0.0f;                                                        \
+      entropy = ma_fma(-lambda, log2(lambda > 0.0f ? lambda : 1.0f), entropy);                                   \
+    }                                                                                                            \
+    return distribution > 0.0f ? entropy : -INFINITY;                                                            \
   }
-  float variance = ma_max(ma_fma(-mu, mu, secondMoment), 0.0f);
-  float Lambda[MA_GRID_MAX_TECHNIQUES], total = 0.0f;
-  for (int j = 0; j < techniqueCount; ++j) {
-    Lambda[j] = ma_fma(cost[j], variance, -meanCost * (sumG2[j] * invCount[j]));
-    total += Lambda[j];
-  }
-  float entropy = 0.0f;
-  int distribution = 1;
-  for (int j = 0; j < techniqueCount; ++j) {
-    float lambda = Lambda[j] / total;
-    distribution &= lambda > 0.0f;
-    entropy = ma_fma(-lambda, fastLog2(lambda > 0.0f ? lambda : 1.0f), entropy);
-  }
-  return distribution ? entropy : -INFINITY;
-}
+MA_DEFINE_ENTROPY_SCORE(entropyScore, float, fastLog2)
+#ifdef __OPENCL_VERSION__
+MA_DEFINE_ENTROPY_SCORE(entropyScore16, float16, fastLog2x16)
+#endif
 
 // The score of weight combination α (cost Σ_k c_k α_k = meanCost) for one pixel, from
 // its running sums (runningSumIndex): rule (a) reads Σ g and Σ g² over each technique's
