@@ -71,7 +71,8 @@ Scene scene(const std::string& envmap, bool split, bool product, EnvmapSampler s
 // the largest GPU's work-group only: the size changes the local arrays' lengths alone,
 // and their 100 variants at the other sizes would cost CI about 7 s. The product
 // technique (M = 3 as with split lobes, its tables' count compiled in) on one map, at
-// those two sizes too.
+// those two sizes too. A CPU's samplePixelStage (alias sampler, no resampling) at 8
+// and 16 lanes.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
   for (const std::string pdf : {"plain", "optimal"})
@@ -99,6 +100,11 @@ std::set<Variant> hostVariants() {
                   variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
                   variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
                 }
+                // A CPU's plain program with samplePixelStage (Sampler), at AVX2's and
+                // AVX-512's float widths.
+                if (sampler == EnvmapSampler::Alias && config.risCandidates == 0)
+                  for (int lanes : {8, 16})
+                    variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), 8, lanes)});
                 if (config.gridSize > 0)
                   variants.insert(
                       {"gridsearch.cl", gridSearchKernelOptions(sampleColumns(s, config), config.optimalWeights)});
