@@ -328,7 +328,7 @@ MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix)
 // Only a λ with every λ_j > 0 is a distribution whose entropy measures the distance
 // to uniform; any other (mixed signs, Σ_j Λ_j = 0) scores −∞.
 // Defined for T = float and, in the kernel, T = float16 (16 combinations at once).
-#define MA_DEFINE_ENTROPY_SCORE(name, T, log2)                                                                   \
+#define MA_DEFINE_ENTROPY_SCORE(name, T, logBase2)                                                               \
   MA_FN T name(int techniqueCount, const T* alpha, T meanCost, const float* cost, const T* sumG, const T* sumG2, \
                const float* invCount) {                                                                          \
     T mu = 0.0f, secondMoment = 0.0f;                                                                            \
@@ -346,7 +346,7 @@ MA_FN void stageMixture(int techniqueCount, PixelSummary added, float* stageMix)
     for (int j = 0; j < techniqueCount; ++j) {                                                                   \
       T lambda = Lambda[j] / total;                                                                              \
       distribution = lambda > 0.0f ? distribution : 0.0f;                                                        \
-      entropy = ma_fma(-lambda, log2(lambda > 0.0f ? lambda : 1.0f), entropy);                                   \
+      entropy = ma_fma(-lambda, logBase2(lambda > 0.0f ? lambda : 1.0f), entropy);                               \
     }                                                                                                            \
     return distribution > 0.0f ? entropy : -INFINITY;                                                            \
   }

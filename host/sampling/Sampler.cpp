@@ -58,6 +58,10 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       pixelLanes, pixelLanes > 0 ? 1 : 0);
 }
 
+int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes) {
+  return scene.tables.useCdf || config.risCandidates > 0 ? 0 : deviceLanes;
+}
+
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
   const EnvmapTables& t = scene.tables;
   texels = upload(device, t.texels);
@@ -90,9 +94,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       },
       localSize);
   localSize_ = shape.localSize;
-  // Measured on haswell (docs/results.md, "One pixel per work-group on a CPU"): the CDF
-  // sampler's searches and resampling's candidates ran slower one pixel per work-group.
-  pixelLanes_ = scene.tables.useCdf || config.risCandidates > 0 ? 0 : limits.pixelLanes;
+  pixelLanes_ = samplePixelLanes(scene, config, limits.pixelLanes);
   share_.launch = shape.why;
   if (pixelLanes_ > 0)
     share_.launch += fmt::format("; stages without running sums: one pixel per {} lanes", pixelLanes_);

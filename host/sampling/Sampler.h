@@ -15,6 +15,13 @@ namespace misalloc {
 // lanes, with 64-bit table reads split in two (docs/pocl.md, rule 10).
 std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes = 0);
 
+// The lanes of samplePixelStage for this scene and config on a device whose
+// DeviceLimits::pixelLanes is `deviceLanes` (0: not a CPU), or 0 where the stages keep
+// sampleStage. Measured on haswell (docs/results.md, "One pixel per work-group on a
+// CPU"): the CDF sampler's searches and resampling's candidates ran slower one pixel per
+// work-group.
+int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes);
+
 // A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
 // that share a context (the sub-devices of one device, cl/Device.h) share one copy, so
 // that their caches hold one set of tables.

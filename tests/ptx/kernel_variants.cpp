@@ -102,8 +102,8 @@ std::set<Variant> hostVariants() {
                 }
                 // A CPU's plain program with samplePixelStage (Sampler), at AVX2's and
                 // AVX-512's float widths.
-                if (sampler == EnvmapSampler::Alias && config.risCandidates == 0)
-                  for (int lanes : {8, 16})
+                for (int deviceLanes : {8, 16})
+                  if (const int lanes = samplePixelLanes(s, config, deviceLanes); lanes > 0)
                     variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), 8, lanes)});
                 if (config.gridSize > 0)
                   variants.insert(
