@@ -4,7 +4,8 @@
 //
 // Compile-time options (sampleKernelOptions in host/sampling/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
-// MA_COSK (< 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
+// MA_ANALYTIC_RADIANCE (1: the map is cos^K θ, K the argument coskExponent, so that every
+// K shares one program; 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
 // bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
 // (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h),
 // MA_PRODUCT_TABLES, MA_PRODUCT_BLOCK_LOG2 and MA_PRODUCT_PLAIN_TEXELS (the product
@@ -112,7 +113,8 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs,
                                        __global const float* productFloats, __global const uint* productWords,
-                                       int width, int height, __local const int* pixelRows, int rowStride, int column,
+                                       int width, int height, float coskExponent, __local const int* pixelRows,
+                                       int rowStride, int column,
                                        MaVec3 mirror, int stageSamples, uint seedLo, uint seedHi, int firstPixel,
                                        int pixel, int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
@@ -125,7 +127,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.useCdf = MA_USE_CDF;
   env.cdfStepsRow = MA_CDF_STEPS_ROW;
   env.cdfStepsCol = MA_CDF_STEPS_COL;
-  env.coskExponent = MA_COSK;
+  env.coskExponent = MA_ANALYTIC_RADIANCE ? coskExponent : -1.0f;
   env.bankShares = MA_BANK_SHARES;
   env.blockLog2 = MA_BANK_BLOCK_LOG2;
   env.blockProbs = blockProbs;
@@ -191,9 +193,9 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 #define MA_SAMPLE_STAGE_PARAMETERS                                                                                  \
   __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                    \
       __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,     \
-      int width, int height, __global const float *brdfParams, float mirrorX, float mirrorY, float mirrorZ,         \
-      __global const int *counts, __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi,      \
-      int firstPixel, int pixelCount, __global const int *pixelOrder, __global ma_acc *estimate,                    \
+      int width, int height, float coskExponent, __global const float *brdfParams, float mirrorX, float mirrorY,    \
+      float mirrorZ, __global const int *counts, __global const uint *firstIndex, int stageSamples, uint seedLo,    \
+      uint seedHi, int firstPixel, int pixelCount, __global const int *pixelOrder, __global ma_acc *estimate,       \
       __global ma_acc *moments, __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, \
       int spareSamples MA_OPTIONAL_PARAMETERS
 
@@ -227,7 +229,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
       SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width,
-                                           height, pixelRows, MA_LOCAL_SIZE, lid, makeVec3(mirrorX, mirrorY, mirrorZ),
+                                           height, coskExponent, pixelRows, MA_LOCAL_SIZE, lid, makeVec3(mirrorX, mirrorY, mirrorZ),
                                            stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
@@ -327,7 +329,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
         // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
         int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
         SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                             width, height, pixelRows, 1, 0, makeVec3(mirrorX, mirrorY, mirrorZ),
+                                             width, height, coskExponent, pixelRows, 1, 0, makeVec3(mirrorX, mirrorY, mirrorZ),
                                              stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
         terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
         terms[TERM_G * CHUNK_SAMPLES + t] = c.g;

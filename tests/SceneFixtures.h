@@ -2,11 +2,15 @@
 // Small scenes and per-pixel statistics shared by the sampler tests.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "Constants.h"
+#include "TestDevice.h"
+#include "TestSize.h"
 #include "render/Method.h"
+#include "sampling/HostSampler.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
 
@@ -27,6 +31,15 @@ inline Scene smallScene(const std::string& envmap, const std::string& grid, int 
   o.viewTheta = viewTheta;
   o.proceduralWidth = 128;
   return makeScene(o);
+}
+
+// The sampler of the statistical sweeps: the C++ reference, which computes the kernel's
+// floats bit for bit on every path the sweeps take (tests/test_sampler.cpp), so that a
+// sweep tests the estimator and not PoCL, and compiles no kernel per scene. With
+// MISALLOC_TEST_SIZE=exhaustive, the kernel on PoCL.
+inline std::unique_ptr<StageSampler> sweepSampler(const Scene& scene, const SamplerConfig& config) {
+  if (exhaustiveTestSize()) return std::make_unique<Sampler>(testDevice(), scene, config);
+  return std::make_unique<HostSampler>(scene, config);
 }
 
 // Mean and standard error of the pixels' luminance estimates, for scenes whose

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -89,9 +90,7 @@ inline ChiSquare chiSquare(const std::vector<uint64_t>& observed, const std::vec
 
 // Šidák: the level each of `checks` independent checks must pass so that all of them
 // together raise a false alarm with probability `familyLevel`.
-inline double sidakLevel(double familyLevel, int checks) {
-  return -std::expm1(std::log1p(-familyLevel) / checks);
-}
+inline double sidakLevel(double familyLevel, int checks) { return -std::expm1(std::log1p(-familyLevel) / checks); }
 
 // The bound that a standard normal variable's |z| exceeds with probability `level`:
 // erfc(z/√2) = level, solved by bisection (erfc falls monotonically).
@@ -103,5 +102,78 @@ inline double twoSidedNormalBound(double level) {
   }
   return 0.5 * (lo + hi);
 }
+
+// z for a one-sided power of 0.9: a bias of (bound + kPowerZ) standard errors exceeds
+// the bound with probability 0.9.
+constexpr double kPowerZ = 1.2815515655446004;
+
+// A family of z-tests for bias: each compares an estimate (mean and standard error) with
+// what it must equal. The family's false-alarm rate is 1e-3 for up to `maxTests` tests
+// (Šidák), and each test states its power: it must detect a relative bias of `detect`
+// with probability 0.9, so a test with too few samples fails instead of passing on noise.
+// samplesFor sizes a test to just that power.
+class BiasFamily {
+ public:
+  BiasFamily(double detect, int maxTests = 100) : detect_(detect), maxTests_(maxTests) {}
+
+  // The error is floored at 1e-6 of the expected value: a zero-variance estimator (f ∝ p)
+  // still rounds each sample's f/(N p) to a float.
+  void add(std::string what, double mean, double expected, double standardError) {
+    tests_.push_back({std::move(what), mean, expected, std::max(standardError, 1e-6 * std::abs(expected))});
+  }
+
+  size_t size() const { return tests_.size(); }
+  double bound() const { return twoSidedNormalBound(sidakLevel(1e-3, maxTests_)); }
+
+  // The relative bias a test of this standard error detects with probability 0.9.
+  double detectable(double standardError, double expected) const {
+    return (bound() + kPowerZ) * standardError / std::abs(expected);
+  }
+  // The largest over the family: what the family guarantees to find.
+  double detectable() const {
+    double worst = 0;
+    for (const Test& t : tests_) worst = std::max(worst, detectable(t.standardError, t.expected));
+    return worst;
+  }
+
+  // The samples that give a test its power, from a pilot's standard error with
+  // pilotSamples (the error falls as 1/√samples), and a margin of 1.5 for the pilot's own
+  // error of its variance.
+  long long samplesFor(double pilotStandardError, long long pilotSamples, double expected) const {
+    const double ratio = detectable(pilotStandardError, expected) / detect_;
+    return (long long)std::ceil(1.5 * double(pilotSamples) * ratio * ratio);
+  }
+
+  // One line per test that failed: |z| past the bound (a bias), or a standard error too
+  // large to detect the stated bias (too few samples); and one if the family outgrew the
+  // bound.
+  std::vector<std::string> failures() const {
+    const double b = bound();
+    std::vector<std::string> out;
+    if (tests_.size() > size_t(maxTests_))
+      out.push_back(std::to_string(tests_.size()) + " tests, more than the " + std::to_string(maxTests_) +
+                    " the bound was set for");
+    for (const Test& t : tests_) {
+      const double z = (t.mean - t.expected) / t.standardError;
+      const double d = detectable(t.standardError, t.expected);
+      const std::string numbers = t.what + ": mean " + std::to_string(t.mean) + " expected " +
+                                  std::to_string(t.expected) + " z " + std::to_string(z) + " (bound " +
+                                  std::to_string(b) + "), detects a bias of " + std::to_string(100 * d) + " %";
+      if (!(std::abs(z) < b)) out.push_back("biased: " + numbers);
+      if (!(d <= detect_))
+        out.push_back("too few samples to detect " + std::to_string(100 * detect_) + " %: " + numbers);
+    }
+    return out;
+  }
+
+ private:
+  struct Test {
+    std::string what;
+    double mean, expected, standardError;
+  };
+  double detect_;
+  int maxTests_;
+  std::vector<Test> tests_;
+};
 
 }  // namespace misalloc::test

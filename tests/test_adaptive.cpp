@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cstring>
 
+#include "BiasCheck.h"
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -22,8 +23,8 @@ Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed) 
   AdaptiveOptions options;
   options.costs.assign(scene.techniqueCount(), 1.0);
   options.oracleSamples = 128;
-  Sampler sampler(testDevice(), scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
-  return render(sampler, method, options, spp, seed);
+  const auto sampler = sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
+  return render(*sampler, method, options, spp, seed);
 }
 
 MeanAndError imageMean(const RgbImage& image) {
@@ -74,20 +75,19 @@ TEST_CASE("adaptive estimates are unbiased against [HS14] eq. 6.17", "[adaptive]
   };
   const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
   uint64_t seed = 500;
+  BiasFamily family(0.02);
   for (const Case& c : cases) {
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
     for (bool split : {false, true}) {
       Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n),
                                32, 32, split);
       for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact, Method::Oracle}) {
-        MeanAndError r = imageMean(renderWith(scene, m, 60, ++seed).image);
-        double z = zScore(r.mean, expected, r.standardError);
-        INFO(fmt::format("rhoD {} n {} K {} split {} {}: mean {} expected {} z {}", c.rhoD, c.n, c.K, split,
-                         methodName(m), r.mean, expected, z));
-        CHECK(std::abs(z) < kMaxZ);
+        addSized(family, fmt::format("rhoD {} n {} K {} split {} {}", c.rhoD, c.n, c.K, split, methodName(m)), expected,
+                 60, 60, ++seed, [&](int spp, uint64_t sd) { return imageMean(renderWith(scene, m, spp, sd).image); });
       }
     }
   }
+  checkFamily(family);
 }
 
 TEST_CASE("adaptive renders are bit-identical for the same seed", "[adaptive][determinism]") {

@@ -98,8 +98,11 @@ void checkMergedIsWhole(const fs::path& dir, const std::vector<std::string>& par
 
 }  // namespace
 
+// [release-only]: the suite's seven maps, read by six processes, cost minutes under the
+// sanitizers; there the next test merges shards of a comparison and runs most of these
+// refusals, on one procedural map.
 TEST_CASE("merged shards of a comparison are the unsharded run: images bit for bit, errors to the digit",
-          "[compare][shard][cli]") {
+          "[compare][shard][cli][release-only]") {
   TempDir dir("compare_shard");
   runWholeAndShards(dir.path, kSuite, "", 3);
   checkMergedIsWhole(dir.path, {shardPath(dir.path, 2), shardPath(dir.path, 0), shardPath(dir.path, 1)});

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "BiasCheck.h"
 #include "CliRunner.h"
 #include "Error.h"
 #include "RunRecords.h"
@@ -17,9 +18,9 @@
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "compare/EnvmapPdfComparison.h"
-#include "render/RunChecks.h"
 #include "render/Reference.h"
 #include "render/Render.h"
+#include "render/RunChecks.h"
 #include "report/Report.h"
 
 using namespace misalloc;
@@ -49,8 +50,13 @@ Rendering renderWith(const Scene& scene, Method method, Estimator estimator, int
   options.costs.assign(scene.techniqueCount(), 1.0);
   options.oracleSamples = 128;
   requireValidRun(scene.options, method, estimator, spp, options);
-  Sampler sampler(testDevice(), scene, samplerConfigFor(method, estimator, spp, options));
-  return render(sampler, method, options, spp, seed);
+  const auto sampler = sweepSampler(scene, samplerConfigFor(method, estimator, spp, options));
+  return render(*sampler, method, options, spp, seed);
+}
+
+MeanAndError imageMean(const Scene& scene, Method method, Estimator estimator, int spp, uint64_t seed) {
+  const Rendering r = renderWith(scene, method, estimator, spp, seed);
+  return pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
 }
 
 // Every method that samples the BRDF, with each estimator it takes.
@@ -165,8 +171,10 @@ TEST_CASE("the compensated pdf refuses schedules that could skip BRDF sampling",
   // envmap sampling alone.
   CHECK_THROWS_AS(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::OneSample, 1, options), InputError);
   CHECK_NOTHROW(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::OneSample, 2, options));
-  CHECK_THROWS_AS(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::MultiSample, 1, options), InputError);
-  CHECK_THROWS_AS(requireValidRun(scene(compensated, 3), Method::Oracle, Estimator::MultiSample, 2, options), InputError);
+  CHECK_THROWS_AS(requireValidRun(scene(compensated, 2), Method::Equal, Estimator::MultiSample, 1, options),
+                  InputError);
+  CHECK_THROWS_AS(requireValidRun(scene(compensated, 3), Method::Oracle, Estimator::MultiSample, 2, options),
+                  InputError);
   // 9 spp in 4 stages: a pilot of 4, then stages of 2, 1, 1, 1: the floor cannot give
   // both techniques one.
   AdaptiveOptions fourStages = options;
@@ -196,6 +204,7 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
   };
   const Case cases[] = {{0.5, 5, 1, "compensated"}, {0.2, 50, 3, "compensated:0.25"}, {0.9, 20, 0.5, "compensated"}};
   uint64_t seed = 900;
+  BiasFamily family(0.02);
   for (const Case& c : cases) {
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
     for (bool split : {false, true})
@@ -210,16 +219,14 @@ TEST_CASE("every method is unbiased with the compensated pdf against [HS14] eq. 
                                        fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), c.pdf, s, split);
         REQUIRE(scene.tables.pdf.compensated());
         for (auto [m, e] : kMethodsWithBrdfSampling) {
-          Rendering r = renderWith(scene, m, e, 60, ++seed);
-          MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
-          double z = zScore(mean.mean, expected, mean.standardError);
-          INFO(fmt::format("rhoD {} n {} K {} {} split {} cdf {} {} one-sample {}: mean {} expected {} z {}", c.rhoD,
-                           c.n, c.K, c.pdf, split, s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample,
-                           mean.mean, expected, z));
-          CHECK(std::abs(z) < kMaxZ);
+          addSized(family,
+                   fmt::format("rhoD {} n {} K {} {} split {} cdf {} {} one-sample {}", c.rhoD, c.n, c.K, c.pdf, split,
+                               s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample),
+                   expected, 60, 60, ++seed, [&](int spp, uint64_t sd) { return imageMean(scene, m, e, spp, sd); });
         }
       }
   }
+  checkFamily(family);
 }
 
 TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17", "[compensated][optimal][unbiased]") {
@@ -232,6 +239,7 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
   // The CDF sampler draws the bank's blocks for the first case only: the blocks' texels
   // and the entries are the alias sampler's.
   uint64_t seed = 1900;
+  BiasFamily family(0.02);
   for (const Case& c : cases)
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
       if ((s == EnvmapSampler::Cdf && &c != &cases[0]) ||
@@ -245,15 +253,13 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
       REQUIRE(scene.tables.hasBank());
       REQUIRE(scene.tables.bankVariances.entriesWithNegativeEq5 > 0);
       for (auto [m, e] : kMethodsWithBrdfSampling) {
-        Rendering r = renderWith(scene, m, e, 60, ++seed);
-        MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
-        double z = zScore(mean.mean, expected, mean.standardError);
-        INFO(fmt::format("rhoD {} n {} K {} optimal cdf {} {} one-sample {}: mean {} expected {} z {}", c.rhoD, c.n,
-                         c.K, s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample, mean.mean, expected,
-                         z));
-        CHECK(std::abs(z) < kMaxZ);
+        addSized(family,
+                 fmt::format("rhoD {} n {} K {} optimal cdf {} {} one-sample {}", c.rhoD, c.n, c.K,
+                             s == EnvmapSampler::Cdf, methodName(m), e == Estimator::OneSample),
+                 expected, 60, 60, ++seed, [&](int spp, uint64_t sd) { return imageMean(scene, m, e, spp, sd); });
       }
     }
+  checkFamily(family);
 }
 
 TEST_CASE("the optimal pdf refuses envmap sampling alone and split BRDF lobes, and reports its bank",

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <memory>
 
+#include "Covering.h"
 #include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -25,9 +26,13 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 }  // namespace
 
 // Neither compiler contracts a*b + c (kernels/sample.cl), so PoCL and g++ compute the
-// same floats in the same order: equal bit for bit, with the product technique too. The optimal pdf's bank (M = 2 only)
-// is read through every BRDF bin of the grid and, as the counts vary, every share. The
-// optimal weights ([Kon19]) run with coefficients of both signs that differ per pixel.
+// same floats in the same order: equal bit for bit, with the product technique too. The
+// optimal pdf's bank (M = 2 only) is read through every BRDF bin of the grid and, as the
+// counts vary, every share. The optimal weights ([Kon19]) run with coefficients of both
+// signs that differ per pixel. A cos^K map takes the analytic radiance of
+// kernels/envmap.h (MA_ANALYTIC_RADIANCE), which every sweep against [HS14] eq. 6.17 runs on the
+// reference. A pairwise covering set of map × pdf × techniques × sampler × sampler
+// configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs every one.
 TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bit for bit", "[sampler]") {
   SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
   shareColumns.shareColumns = true;  // with the optimal pdf
@@ -41,65 +46,80 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
       shareColumns,
       optimalWeights,
   };
-  for (const char* pdf : {"plain", "optimal"}) {
-    for (int techniques : {0, 1, 2}) {  // the BRDF as one technique, split, or with the product
-      const bool split = techniques == 1, product = techniques == 2;
-      if (split && std::string(pdf) == "optimal") continue;
-      for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
-        // The product's tables do not depend on the sampler: the CDF sampler with the
-        // optimal pdf's bank adds PoCL compiles to CI, no path.
-        if (product && std::string(pdf) == "optimal" && s == EnvmapSampler::Cdf) continue;
-        const Scene scene = smallScene("venice_sunset", "seed000", 24, 16, split, s, 0, pdf,
-                                       product);  // once per map and sampler
-        if (std::string(pdf) == "optimal") REQUIRE(scene.tables.brdfBins > 1);
-        for (const SamplerConfig& config : configs) {
-          StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
-          // Counts that differ from pixel to pixel, each technique at least one: work-groups
-          // then mix counts (kernels/sample.cl runs each technique's loop for the largest).
-          const int M = plan.techniqueCount;
-          for (int p = 0; p < scene.pixelCount(); ++p) {
-            int32_t* n = plan.counts.data() + size_t(p) * M;
-            n[0] = 1 + (p * 7) % 45;
-            n[M - 1] = 50 - n[0] - (M - 2) * (1 + p % 3);
-            if (M == 3) n[1] = 1 + p % 3;
+  struct Case {
+    std::string map, pdf;
+    int techniques;  // the BRDF as one technique (0), split (1), or with the product (2)
+    EnvmapSampler sampler;
+    int config;
+  };
+  std::vector<Case> cases;
+  std::vector<Configuration> settings;
+  for (const std::string map : {"venice_sunset", "cosk:2"})
+    for (const std::string pdf : {"plain", "optimal"})
+      for (int techniques : {0, 1, 2})
+        for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
+          for (int config = 0; config < int(std::size(configs)); ++config) {
+            if (techniques == 1 && pdf == "optimal") continue;  // the optimal pdf takes no split lobes
+            // The product's tables do not depend on the sampler: the CDF sampler with the
+            // optimal pdf's bank adds PoCL compiles to CI, no path.
+            if (techniques == 2 && pdf == "optimal" && s == EnvmapSampler::Cdf) continue;
+            cases.push_back({map, pdf, techniques, s, config});
+            settings.push_back({"map=" + map, "pdf=" + pdf, fmt::format("techniques={}", techniques),
+                                fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("config={}", config)});
           }
-          plan.optimalCoefficients.clear();
-          if (config.optimalWeights)
-            for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)
-              plan.optimalCoefficients.push_back(0.02f * float(int(i * 37 % 101) - 50));
-          Sampler device(testDevice(), scene, config);
-          HostSampler host(scene, config);
-          size_t mismatches = 0;
-          // Two stages, so that the running sums and stored samples carry over, and a last
-          // stage without them (on a CPU with the alias sampler, samplePixelStage) whose
-          // counts span several of its chunks of terms.
-          for (int stage = 0; stage < 3; ++stage) {
-            const int scale = stage == 2 ? 3 : 1;
-            StagePlan s = plan;
-            s.keepStatistics = stage < 2;
-            s.stageSamples = 50 * scale;
-            s.samplesBefore = 50 * stage;
-            for (size_t i = 0; i < plan.counts.size(); ++i) {
-              s.counts[i] = plan.counts[i] * scale;
-              s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
-            }
-            StageResult a = device.run(s, 42), b = host.run(s, 42);
-            for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-            for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
-          }
-          std::vector<double> statsA = device.statistics(), statsB = host.statistics();
-          REQUIRE(statsA.size() == statsB.size());
-          for (size_t i = 0; i < statsA.size(); ++i) mismatches += statsA[i] != statsB[i];
-          std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
-          REQUIRE(storedA.size() == storedB.size());
-          for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
-          INFO(fmt::format("{} split {} product {} cdf {} estimator {} stats {} stored {} optimal weights {}", pdf,
-                           split, product, s == EnvmapSampler::Cdf, int(config.estimator), config.statsMask,
-                           config.sampleCapacity, config.optimalWeights));
-          CHECK(mismatches == 0);
-        }
-      }
+  std::vector<size_t> chosen(cases.size());
+  for (size_t i = 0; i < cases.size(); ++i) chosen[i] = i;
+  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
+  for (size_t c : chosen) {
+    const Case& cs = cases[c];
+    const SamplerConfig& config = configs[cs.config];
+    const bool split = cs.techniques == 1, product = cs.techniques == 2;
+    const Scene scene = smallScene(cs.map, "seed000", 24, 16, split, cs.sampler, 0, cs.pdf, product);
+    if (cs.pdf == "optimal") REQUIRE(scene.tables.brdfBins > 1);
+    StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
+    // Counts that differ from pixel to pixel, each technique at least one: work-groups
+    // then mix counts (kernels/sample.cl runs each technique's loop for the largest).
+    const int M = plan.techniqueCount;
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      int32_t* n = plan.counts.data() + size_t(p) * M;
+      n[0] = 1 + (p * 7) % 45;
+      n[M - 1] = 50 - n[0] - (M - 2) * (1 + p % 3);
+      if (M == 3) n[1] = 1 + p % 3;
     }
+    plan.optimalCoefficients.clear();
+    if (config.optimalWeights)
+      for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)
+        plan.optimalCoefficients.push_back(0.02f * float(int(i * 37 % 101) - 50));
+    Sampler device(testDevice(), scene, config);
+    HostSampler host(scene, config);
+    size_t mismatches = 0;
+    // Two stages, so that the running sums and stored samples carry over, and a last
+    // stage without them (on a CPU with the alias sampler, samplePixelStage) whose
+    // counts span several of its chunks of terms.
+    for (int stage = 0; stage < 3; ++stage) {
+      const int scale = stage == 2 ? 3 : 1;
+      StagePlan s = plan;
+      s.keepStatistics = stage < 2;
+      s.stageSamples = 50 * scale;
+      s.samplesBefore = 50 * stage;
+      for (size_t i = 0; i < plan.counts.size(); ++i) {
+        s.counts[i] = plan.counts[i] * scale;
+        s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
+      }
+      StageResult a = device.run(s, 42), b = host.run(s, 42);
+      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+    }
+    std::vector<double> statsA = device.statistics(), statsB = host.statistics();
+    REQUIRE(statsA.size() == statsB.size());
+    for (size_t i = 0; i < statsA.size(); ++i) mismatches += statsA[i] != statsB[i];
+    std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
+    REQUIRE(storedA.size() == storedB.size());
+    for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
+    INFO(fmt::format("{} {} split {} product {} cdf {} estimator {} stats {} stored {} optimal weights {}", cs.map,
+                     cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, int(config.estimator), config.statsMask,
+                     config.sampleCapacity, config.optimalWeights));
+    CHECK(mismatches == 0);
   }
 }
 
@@ -156,21 +176,23 @@ TEST_CASE("a stored sample's share columns hold the pdf of each share, its own s
 
 // ris's candidate loop, unrolled in the kernel and a loop in the reference. The default
 // candidates on a map whose kernel tests/test_devices.cpp builds too: PoCL compiles an
-// unrolled loop for seconds per candidate count (docs/pocl.md).
+// unrolled loop for seconds per candidate count (docs/pocl.md). On a cos^K map as well,
+// whose analytic radiance the resampling sweeps against [HS14] eq. 6.17 take.
 TEST_CASE("resampled sampling on PoCL matches its C++ reference bit for bit", "[sampler][ris]") {
-  for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
-    const Scene scene = smallScene("rooitou_park", "seed000", 24, 16, false, s);
-    const SamplerConfig config = samplerConfigFor(Method::Ris, Estimator::MultiSample, 50, AdaptiveOptions{});
-    Sampler device(testDevice(), scene, config);
-    HostSampler host(scene, config);
-    const StagePlan plan = singleStagePlan(scene, Method::Ris, 50);
-    StageResult a = device.run(plan, 42), b = host.run(plan, 42);
-    size_t mismatches = 0;
-    for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-    for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
-    INFO(fmt::format("cdf {}", s == EnvmapSampler::Cdf));
-    CHECK(mismatches == 0);
-  }
+  for (const std::string map : {"rooitou_park", "cosk:2"})
+    for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
+      const Scene scene = smallScene(map, "seed000", 24, 16, false, s);
+      const SamplerConfig config = samplerConfigFor(Method::Ris, Estimator::MultiSample, 50, AdaptiveOptions{});
+      Sampler device(testDevice(), scene, config);
+      HostSampler host(scene, config);
+      const StagePlan plan = singleStagePlan(scene, Method::Ris, 50);
+      StageResult a = device.run(plan, 42), b = host.run(plan, 42);
+      size_t mismatches = 0;
+      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+      INFO(fmt::format("{} cdf {}", map, s == EnvmapSampler::Cdf));
+      CHECK(mismatches == 0);
+    }
 }
 
 // With one candidate, resampling keeps the envmap technique's own sample: the same

@@ -39,13 +39,17 @@ namespace {
 
 const std::vector<Method> kAdaptive = {Method::Heuristic, Method::SigmaSqrtC, Method::Linear, Method::Exact};
 
+// On the sweeps' sampler (tests/SceneFixtures.h), or, given a work-group size, on PoCL.
 Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed, std::vector<double> costs = {},
-                     int localSize = 8) {
+                     int deviceLocalSize = 0) {
   AdaptiveOptions options;
   options.costs = costs.empty() ? std::vector<double>(scene.techniqueCount(), 1.0) : costs;
   options.oracleSamples = 128;
-  Sampler sampler(testDevice(), scene, samplerConfigFor(method, Estimator::MultiSample, spp, options), localSize);
-  return render(sampler, method, options, spp, seed);
+  const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, spp, options);
+  const std::unique_ptr<StageSampler> sampler =
+      deviceLocalSize > 0 ? std::make_unique<Sampler>(testDevice(), scene, config, deviceLocalSize)
+                          : sweepSampler(scene, config);
+  return render(*sampler, method, options, spp, seed);
 }
 
 MeanAndError imageMean(const Rendering& r) {
@@ -348,9 +352,10 @@ TEST_CASE("1x1 and 2x1 maps: unbiased against the constant's closed form", "[sta
 
 TEST_CASE("a 16384x8192 map: tables sum to 1 in double and sampling stays unbiased", "[stability][large]") {
   // constant:1 at width 16384: 1.3e8 texels. The table precision is checked on the host;
-  // a few pixels sample it on the device against the closed form ρd + ρs. Both
-  // samplers: the alias table's 32-bit bucket index and the CDFs' 24-bit uniforms over
-  // 16384 columns.
+  // a few pixels sample it against the closed form ρd + ρs. Both samplers: the alias
+  // table's 32-bit bucket index and the CDFs' 24-bit uniforms over 16384 columns. Small
+  // test size (the sanitizers): 4096 × 2048, 8.4e6 texels, through the same code.
+  const int width = smallTestSize() ? 4096 : 16384;
   for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
     auto start = std::chrono::steady_clock::now();
     SceneOptions o;
@@ -358,14 +363,14 @@ TEST_CASE("a 16384x8192 map: tables sum to 1 in double and sampling stays unbias
     o.grid = "uniform:0.5,0.5,10";
     o.width = 8;
     o.height = 8;
-    o.proceduralWidth = 16384;
+    o.proceduralWidth = width;
     o.sampler = sampler;
     Scene scene = makeScene(o);
-    REQUIRE(scene.tables.width == 16384);
-    REQUIRE(scene.tables.height == 8192);
+    REQUIRE(scene.tables.width == width);
+    REQUIRE(scene.tables.height == width / 2);
     double total = 0;
     size_t bad = 0;
-    const size_t texels = size_t(16384) * 8192;
+    const size_t texels = size_t(width) * (width / 2);
     for (size_t t = 0; t < texels; ++t) {
       double p = scene.tables.texels[4 * t + 3];
       total += p;
@@ -516,8 +521,8 @@ TEST_CASE("pixels whose true value is 0 (a black BRDF): exact zeros, relative er
 // ---------------------------------------------------------------------------------
 
 TEST_CASE("1e7 samples per pixel: the accumulated estimate keeps double precision", "[stability][precision]") {
-  // One work-item: float sums would drift by ~1e-4 relative after 1e7 terms, far
-  // beyond the standard error of ~1e-4/√... of this low-variance integrand.
+  // One work-item of the kernel: float sums would drift by ~1e-4 relative after 1e7
+  // terms, far beyond the standard error of ~1e-4/√... of this low-variance integrand.
   Scene scene = smallScene("cosk:1", "uniform:0.5,0.5,5", 1, 1);
   const double expected = closedForm(0.5, 0.5, 5, 1);
   Rendering r = renderWith(scene, Method::Equal, 10000000, 14000, {}, 1);

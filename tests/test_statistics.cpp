@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "Statistics.h"
@@ -36,4 +37,27 @@ TEST_CASE("the Šidák level keeps the family's false-alarm rate", "[statistics]
   double level = sidakLevel(0.01, 20);
   CHECK(1 - std::pow(1 - level, 20) == Approx(0.01).epsilon(1e-12));
   CHECK(sidakLevel(0.02, 20) > 1e-3);
+}
+
+TEST_CASE("a bias family fails a biased test and an underpowered one, and sizes a test to its power", "[statistics]") {
+  BiasFamily family(0.01, 10);
+  const double bound = family.bound();  // Šidák over 10 tests at 1e-3
+  CHECK(bound == Approx(twoSidedNormalBound(sidakLevel(1e-3, 10))));
+  // A standard error that detects exactly 1 %: (bound + z_0.9) · se = 0.01.
+  const double se = 0.01 / (bound + kPowerZ);
+  family.add("fair", 1.0 + 0.5 * se, 1.0, se);
+  CHECK(family.failures().empty());
+  CHECK(family.detectable() == Approx(0.01));
+  family.add("biased", 1.0 + 1.01 * bound * se, 1.0, se);
+  family.add("noisy", 1.0, 1.0, 1.01 * se);
+  const std::vector<std::string> failures = family.failures();
+  REQUIRE(failures.size() == 2);
+  CHECK(failures[0].rfind("biased: biased", 0) == 0);
+  CHECK(failures[1].rfind("too few samples", 0) == 0);
+  // Four times the error needs 16 times the samples, and the pilot's margin of 1.5.
+  const long long samples = family.samplesFor(4 * se, 100, 1.0);
+  CHECK(samples >= 2400);
+  CHECK(samples <= 2401);
+  for (int i = 0; i < 8; ++i) family.add("more", 1.0, 1.0, se);
+  CHECK(family.failures().size() == 3);  // 11 tests: more than the bound was set for
 }

@@ -1,12 +1,14 @@
-// Compiles every variant of the two OpenCL programs that the host can build to NVIDIA
-// PTX with clang, so that a kernel edit that only a GPU compiler would reject fails here,
-// on a machine without a GPU. The variants come from the host's own option builders
+// Compiles the variants of the two OpenCL programs that the host can build to NVIDIA PTX
+// with clang, so that a kernel edit that only a GPU compiler would reject fails here, on
+// a machine without a GPU. The variants come from the host's own option builders
 // (sampleKernelOptions, gridSearchKernelOptions) over the scenes, methods, estimators and
-// work-group sizes it uses.
+// work-group sizes it uses. By default a pairwise covering set of them compiles
+// (tests/Covering.h: every pair of -D settings that some variant holds); with
+// MISALLOC_TEST_SIZE=exhaustive (scripts/exhaustive-tests) every one.
 //
 // Usage: ptx_kernel_variants CLANG KERNEL_DIR RANDOM123_INCLUDE_DIR
-// Exit 0: every variant compiled; 1: at least one did not (each is printed with its
-// options and clang's messages); 77: clang or its nvptx64 target is missing (a skip).
+// Exit 0: every chosen variant compiled; 1: at least one did not (each is printed with
+// its options and clang's messages); 77: clang or its nvptx64 target is missing (a skip).
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -26,6 +28,8 @@
 #include <utility>
 #include <vector>
 
+#include "../Covering.h"
+#include "../TestSize.h"
 #include "Error.h"
 #include "alloc/GridSearch.h"
 #include "render/Method.h"
@@ -67,12 +71,11 @@ Scene scene(const std::string& envmap, bool split, bool product, EnvmapSampler s
 // takes them (render/RunChecks.h), at each work-group size, and the grid search where
 // the config asks for one (Sampler's constructor); not those of runs that
 // requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank (M = 2
-// only) on one map: the map changes MA_COSK alone. The optimal weights at the CPU's and
-// the largest GPU's work-group only: the size changes the local arrays' lengths alone,
-// and their 100 variants at the other sizes would cost CI about 7 s. The product
-// technique (M = 3 as with split lobes, its tables' count compiled in) on one map, at
-// those two sizes too. A CPU's samplePixelStage (alias sampler, no resampling) at 8
-// and 16 lanes.
+// only) on one map: the map changes MA_ANALYTIC_RADIANCE alone. Work-groups of the CPU's size and the
+// largest GPU's: the size changes the local arrays' lengths alone, which `clang -S`
+// does not hold against a device's limits. The product technique (M = 3 as with split
+// lobes, its tables' count compiled in) on one map. A CPU's samplePixelStage (alias
+// sampler, no resampling) at 8 and 16 lanes.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
   for (const std::string pdf : {"plain", "optimal"})
@@ -95,8 +98,7 @@ std::set<Variant> hostVariants() {
                   continue;
                 }
                 SamplerConfig config = samplerConfigFor(method, estimator, 64, options);
-                for (int localSize : {8, 64, 128, 256}) {
-                  if ((config.optimalWeights || product) && localSize != 8 && localSize != 256) continue;
+                for (int localSize : {8, 256}) {
                   variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
                   variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
                 }
@@ -185,7 +187,17 @@ int main(int argc, char** argv) {
   }
 
   const std::set<Variant> variantSet = hostVariants();
-  const std::vector<Variant> variants(variantSet.begin(), variantSet.end());
+  const std::vector<Variant> every(variantSet.begin(), variantSet.end());
+  std::vector<Variant> variants = every;
+  if (!test::exhaustiveTestSize()) {
+    std::vector<test::Configuration> settings;
+    for (const Variant& v : every) {
+      settings.push_back(words(v.options));
+      settings.back().push_back("file=" + v.file);
+    }
+    variants.clear();
+    for (size_t i : test::pairwiseCovering(settings)) variants.push_back(every[i]);
+  }
   auto argsOf = [&](const Variant& v) {
     std::vector<std::string> args{clang,
                                   "-x",
@@ -205,7 +217,8 @@ int main(int argc, char** argv) {
   };
 
   const auto start = std::chrono::steady_clock::now();
-  const size_t jobs = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 4);
+  // As many as ctest reserves for it (PROCESSORS in tests/CMakeLists.txt).
+  const size_t jobs = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 2);
   std::vector<std::pair<pid_t, size_t>> running;  // (process, variant)
   std::vector<size_t> failed;
   auto reap = [&]() {
@@ -239,9 +252,10 @@ int main(int argc, char** argv) {
     return std::count_if(variants.begin(), variants.end(), [&](const Variant& v) { return v.file == file; });
   };
   std::cout << variants.size() - failed.size() << " of " << variants.size() << " kernel variants ("
-            << count("sample.cl") << " of sample.cl, " << count("gridsearch.cl")
-            << " of gridsearch.cl) compiled to PTX (nvptx64-nvidia-nvcl) in " << seconds << " s, " << jobs
-            << " at a time\n";
+            << count("sample.cl") << " of sample.cl, " << count("gridsearch.cl") << " of gridsearch.cl; "
+            << every.size() << " host variants, "
+            << (variants.size() < every.size() ? "a pairwise covering set" : "all of them")
+            << ") compiled to PTX (nvptx64-nvidia-nvcl) in " << seconds << " s, " << jobs << " at a time\n";
   std::filesystem::remove_all(tmp);
   return failed.empty() ? 0 : 1;
 }
