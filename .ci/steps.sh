@@ -1,4 +1,4 @@
-# Sourced by .ci/setup, .ci/sanitized-tests and scripts/test-suite.
+# Sourced by .ci/setup and scripts/test-suite.
 # step NAME COMMAND...: runs COMMAND; where MISALLOC_CI_TIMES names a folder, appends a
 # line "NAME start end" (seconds since the epoch) to its steps.tsv, which scripts/ci-times
 # reads. A failing COMMAND fails the script (set -e) before anything is written.

@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <string>
 
+#include "TestBinary.h"
+
 namespace misalloc::test {
 
 struct CommandResult {
@@ -18,7 +20,7 @@ struct CommandResult {
 };
 
 inline CommandResult runMisalloc(const std::string& args, const std::string& environment = "") {
-  std::string command = fmt::format("{} {} {} 2>&1", environment, MISALLOC_BINARY, args);
+  std::string command = fmt::format("{} {} {} 2>&1", environment, misallocBinary(), args);
   FILE* pipe = popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);
   std::string output;

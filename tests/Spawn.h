@@ -9,12 +9,14 @@
 #include <string>
 #include <thread>
 
+#include "TestBinary.h"
+
 namespace misalloc::test {
 
 // misalloc with `args` in a process of its own, its stdout and stderr to `log`.
 inline pid_t spawnMisalloc(const std::string& args, const std::string& environment = "",
                            const std::string& log = "/dev/null") {
-  const std::string command = fmt::format("exec env {} {} {} >'{}' 2>&1", environment, MISALLOC_BINARY, args, log);
+  const std::string command = fmt::format("exec env {} {} {} >'{}' 2>&1", environment, misallocBinary(), args, log);
   pid_t pid = fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {

@@ -204,7 +204,7 @@ TEST_CASE("an interrupted compare stops with every file complete", "[cli][compar
   const std::string args = fmt::format(
       "{} compare --envmap cosk:2 --size 16x16 --budgets 8,16,32,64,128 --repeats 8 --device cpu --out-dir {} "
       "--cache-dir {} >{} 2>&1",
-      MISALLOC_BINARY, out.string(), (dir.path / "cache").string(), log.string());
+      misalloc::test::misallocBinary(), out.string(), (dir.path / "cache").string(), log.string());
   pid_t pid = 0;
   const char* argv[] = {"sh", "-c", args.c_str(), nullptr};
   // exec, not a child shell, so that the signal reaches misalloc itself.

@@ -22,6 +22,7 @@
 #include "Constants.h"
 #include "KernelCode.h"
 #include "SceneFixtures.h"
+#include "TestBinary.h"
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "paper/MixtureOptimizer.h"
@@ -350,12 +351,14 @@ TEST_CASE("1x1 and 2x1 maps: unbiased against the constant's closed form", "[sta
   std::remove(two.c_str());
 }
 
-TEST_CASE("a 16384x8192 map: tables sum to 1 in double and sampling stays unbiased", "[stability][large]") {
-  // constant:1 at width 16384: 1.3e8 texels. The table precision is checked on the host;
-  // a few pixels sample it against the closed form ρd + ρs. Both samplers: the alias
-  // table's 32-bit bucket index and the CDFs' 24-bit uniforms over 16384 columns. Small
-  // test size (the sanitizers): 4096 × 2048, 8.4e6 texels, through the same code.
-  const int width = smallTestSize() ? 4096 : 16384;
+TEST_CASE("a map past 2^24 texels: tables sum to 1 in double and sampling stays unbiased", "[stability][large]") {
+  // constant:1 at width 8192: 3.4e7 texels, past the 2^24 that a float counts exactly
+  // and a 24-bit uniform resolves. The table precision is checked on the host; a few
+  // pixels sample it against the closed form ρd + ρs. Both samplers: the alias table's
+  // 32-bit bucket index and the CDFs' 24-bit uniforms over 8192 columns. Exhaustive test
+  // size: 16384 × 8192 (1.3e8 texels, 4× the time); small (the sanitizers): 4096 × 2048,
+  // through the same code.
+  const int width = smallTestSize() ? 4096 : exhaustiveTestSize() ? 16384 : 8192;
   for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
     auto start = std::chrono::steady_clock::now();
     SceneOptions o;
@@ -577,7 +580,7 @@ TEST_CASE("reports of hard scenes hold only finite numbers and count the defensi
       std::string command = fmt::format(
           "{} render {} --size 8x8 --spp 20 --method {} --reference-spp 64 --cache-dir {} --out {} "
           "--report {} 2>&1",
-          MISALLOC_BINARY, c.scene, method, (dir / "cache").string(), out.string(), report.string());
+          misallocBinary(), c.scene, method, (dir / "cache").string(), out.string(), report.string());
       FILE* pipe = popen(command.c_str(), "r");
       REQUIRE(pipe != nullptr);
       std::string output;
