@@ -111,6 +111,7 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
 
 TEST_CASE("a failed device's tiles run again on the others: the same image", "[devices]") {
   const Scene scene = smallScene("studio_small_03", "seed000", 40, 26);
+  int injected = 0;
   for (Method method : {Method::Equal, Method::Heuristic, Method::Exact}) {
     AdaptiveOptions options = fixedCosts(scene);
     const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 48, options);
@@ -124,9 +125,14 @@ TEST_CASE("a failed device's tiles run again on the others: the same image", "[d
     CHECK(sameBits(expected.image, r.image));
     CHECK(expected.alpha == r.alpha);
     REQUIRE(r.devices.size() == 2);
-    CHECK(r.devices[1].failure == "injected failure");
     CHECK(r.devices[0].failure.empty());
+    // The tiles go to whichever member asks first: under load (the sanitized tests beside
+    // the Release ones) the healthy member can take every tile of a render before the
+    // other asks for its second, and then nothing failed.
+    CHECK((r.devices[1].failure.empty() || r.devices[1].failure == "injected failure"));
+    injected += r.devices[1].failure == "injected failure";
   }
+  CHECK(injected > 0);
 }
 
 TEST_CASE("with every device failed the render stops with a DeviceError", "[devices]") {
