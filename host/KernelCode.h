@@ -14,5 +14,6 @@ namespace misalloc::kern {
 #include "estimator.h"
 #include "fallbacks.h"
 #include "pixel.h"
+#include "pixel_layout.h"
 #include "stats.h"
 }  // namespace misalloc::kern

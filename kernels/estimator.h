@@ -11,11 +11,19 @@
 #include "product.h"
 #include "rng.h"
 
-// Technique 0 samples the envmap. With the BRDF as one technique, 1 samples BRDF×cos
-// (the mixture of both lobes); split into lobes, 1 is the cosine lobe, 2 the Phong lobe.
-// With the product technique (kernels/product.h), 2 samples envmap × BRDF × cos.
-#define MA_TECHNIQUE_ENVMAP 0
-#define MA_TECHNIQUE_PRODUCT 2
+// What a technique samples, its role, named once for the kernels and the host
+// (host/scene/Scene.h): technique 0 samples the envmap; technique 1 BRDF × cos (the
+// mixture of both lobes) or, with the BRDF split into lobes (--split-brdf), the cosine
+// lobe; technique 2 the Phong lobe (--split-brdf) or envmap × BRDF × cos (--product,
+// kernels/product.h).
+enum { ROLE_ENVMAP, ROLE_BRDF, ROLE_DIFFUSE, ROLE_SPECULAR, ROLE_PRODUCT, ROLE_COUNT };
+#define MA_TECHNIQUE_ENVMAP 0  // the envmap's technique in every set
+
+MA_FN int techniqueRole(int splitBrdf, int product, int technique) {
+  if (technique == MA_TECHNIQUE_ENVMAP) return ROLE_ENVMAP;
+  if (technique == 1) return splitBrdf ? ROLE_DIFFUSE : ROLE_BRDF;
+  return product ? ROLE_PRODUCT : ROLE_SPECULAR;
+}
 
 typedef struct {
   int techniqueCount;             // M
@@ -31,12 +39,15 @@ typedef struct {
   int texel;  // techniques that draw a texel (drawsTexel): the envmap texel it drew wi in
 } TechniqueSample;
 
-MA_FN int isProductTechnique(TechniqueSet ts, int technique) {
-  return ts.product.tables > 0 && technique == MA_TECHNIQUE_PRODUCT;
+MA_FN int roleOf(TechniqueSet ts, int technique) {
+  return techniqueRole(ts.splitBrdf, ts.product.tables > 0, technique);
 }
 
+MA_FN int isProductTechnique(TechniqueSet ts, int technique) { return roleOf(ts, technique) == ROLE_PRODUCT; }
+
 MA_FN int drawsTexel(TechniqueSet ts, int technique) {
-  return technique == MA_TECHNIQUE_ENVMAP || isProductTechnique(ts, technique);
+  int role = roleOf(ts, technique);
+  return role == ROLE_ENVMAP || role == ROLE_PRODUCT;
 }
 
 // mixtureU: the product technique's choice of table (sampleProduct); unused by the others.
@@ -44,30 +55,35 @@ MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongPara
                                       float mixtureU) {
   TechniqueSample s;
   s.texel = 0;
+  int role = roleOf(ts, technique);
   if (drawsTexel(ts, technique)) {
-    EnvmapSample e = technique == MA_TECHNIQUE_ENVMAP
-                         ? sampleEnvmap(env, rnd)
-                         : sampleProduct(env, ts.product, ts.productMixture, rnd, mixtureU);
+    EnvmapSample e =
+        role == ROLE_ENVMAP ? sampleEnvmap(env, rnd) : sampleProduct(env, ts.product, ts.productMixture, rnd, mixtureU);
     s.wi = e.w;
     s.texel = e.texel;
-  } else if (!ts.splitBrdf) {
+  } else if (role == ROLE_BRDF) {
     s.wi = sampleBrdf(b, ts.mirror, rnd);
   } else {
     float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
-    s.wi = technique == 1 ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
+    s.wi = role == ROLE_DIFFUSE ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
   }
   return s;
 }
 
-// p_k(ω_i) of every technique, given the envmap's pdf and the Phong lobe at ω_i, which
-// lies in texel t at sin θ = sinTheta.
+// p_k(ω_i) of every technique (0 past the last), given the envmap's pdf and the Phong
+// lobe at ω_i, which lies in texel t at sin θ = sinTheta.
 MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi, int t, float sinTheta,
                          float envmapPdf, float lobe, float* pdfs) {
-  pdfs[0] = envmapPdf;
-  pdfs[1] = ts.splitBrdf ? diffusePdf(wi) : brdfPdf(b, wi, lobe);
-  pdfs[2] = ts.splitBrdf            ? specularPdf(b, lobe)
-            : ts.product.tables > 0 ? productPdf(env, ts.product, ts.productMixture, t, envmapPdf, sinTheta)
-                                    : 0.0f;
+  MA_UNROLL
+  for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) {
+    int role = roleOf(ts, k);
+    pdfs[k] = k >= ts.techniqueCount  ? 0.0f
+              : role == ROLE_ENVMAP   ? envmapPdf
+              : role == ROLE_BRDF     ? brdfPdf(b, wi, lobe)
+              : role == ROLE_DIFFUSE  ? diffusePdf(wi)
+              : role == ROLE_SPECULAR ? specularPdf(b, lobe)
+                                      : productPdf(env, ts.product, ts.productMixture, t, envmapPdf, sinTheta);
+  }
 }
 
 // [HS14] eq. 4.3: the balance heuristic is importance sampling from Σ_k α_k p_k.

@@ -7,6 +7,7 @@
 #ifndef MA_PIXEL_H
 #define MA_PIXEL_H
 #include "estimator.h"
+#include "pixel_layout.h"
 #include "ris.h"
 
 typedef struct {
@@ -22,8 +23,8 @@ typedef struct {
 MA_FN StageCounts loadStageCounts(MA_GLOBAL const int* counts, MA_GLOBAL const ma_uint* firstIndex, int pixel,
                                   int techniqueCount, int stageSamples, int oneSample, int countIndependent,
                                   int risCandidates) {
-  MA_GLOBAL const int* n = counts + pixel * techniqueCount;
-  MA_GLOBAL const ma_uint* first = firstIndex + pixel * techniqueCount;
+  MA_GLOBAL const int* n = counts + countsOffset(pixel, techniqueCount);
+  MA_GLOBAL const ma_uint* first = firstIndex + countsOffset(pixel, techniqueCount);
   StageCounts c;
   c.techniqueCount = techniqueCount;
   c.stageSamples = stageSamples;

@@ -30,33 +30,19 @@
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
 #define SAMPLE_COLUMNS MA_STORED_COLUMNS(MA_TECHNIQUES, MA_SHARE_COLUMNS)
 
-// The per-pixel sums live in local memory, one row per sum: PoCL then keeps nothing
-// but the loop counter across the barrier, and nothing that its earlier passes could
-// pack into short vectors, which would stop it vectorising across work-items.
-enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
-
-// What a pixel's samples share, read from global memory once, before the sample loop,
-// into one row of local memory per value, as the sums: the loop keeps nothing across its
-// barrier, and reads local memory at the work-item's index instead of global memory at
-// the pixel's. PoCL's haswell target has no gather instruction, so each read at the
-// pixel's index was one scalar load per lane (docs/pocl.md, "How misalloc's kernels
-// apply them").
-enum {
-  ROW_RHO_D,
-  ROW_RHO_S,
-  ROW_N,
-  ROW_BRDF_BIN,
-  ROW_N0,
-  ROW_N1,
-  ROW_N2,
-  ROW_FIRST0,
-  ROW_FIRST1,
-  ROW_FIRST2,
-  ROW_COEFFICIENTS  // --weights optimal: a_{c,k} at row ROW_COEFFICIENTS + c·M + k
-};
-// --product: the pixel's ProductMixture (diffuse, specular, specular table) after them.
-#define ROW_PRODUCT (ROW_COEFFICIENTS + (MA_OPTIMAL_WEIGHTS ? 3 * MA_TECHNIQUES : 0))
-#define ROW_COUNT (ROW_PRODUCT + (MA_PRODUCT_TABLES > 0 ? 3 : 0))
+// The per-pixel sums live in local memory, one row per sum (SUM_*, kernels/pixel_layout.h):
+// PoCL then keeps nothing but the loop counter across the barrier, and nothing that its
+// earlier passes could pack into short vectors, which would stop it vectorising across
+// work-items.
+//
+// What a pixel's samples share is read from global memory once, before the sample loop,
+// into one row of local memory per value (ROW_*, kernels/pixel_layout.h), as the sums:
+// the loop keeps nothing across its barrier, and reads local memory at the work-item's
+// index instead of global memory at the pixel's. PoCL's haswell target has no gather
+// instruction, so each read at the pixel's index was one scalar load per lane
+// (docs/pocl.md, "How misalloc's kernels apply them").
+#define ROW_PRODUCT MA_ROW_PRODUCT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES)
+#define ROW_COUNT MA_PIXEL_ROW_COUNT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0)
 
 MA_FN ProductView productView(__global const float* productFloats, __global const uint* productWords) {
   ProductView p;
@@ -76,10 +62,11 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                             MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  int rowValues[ROW_COEFFICIENTS] = {as_int(brdfParams[4 * pixel + 0]),
-                                     as_int(brdfParams[4 * pixel + 1]),
-                                     as_int(brdfParams[4 * pixel + 2]),
-                                     as_int(brdfParams[4 * pixel + 3]),
+  __global const float* brdf = brdfParams + brdfOffset(pixel);
+  int rowValues[ROW_COEFFICIENTS] = {as_int(brdf[0]),
+                                     as_int(brdf[1]),
+                                     as_int(brdf[2]),
+                                     as_int(brdf[3]),
                                      pixelCounts.n0,
                                      pixelCounts.n1,
                                      pixelCounts.n2,
@@ -91,14 +78,14 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #if MA_OPTIMAL_WEIGHTS
   MA_UNROLL
   for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
-    PIXEL_ROW(ROW_COEFFICIENTS + r) = as_int(coefficients[pixel * 3 * MA_TECHNIQUES + r]);
+    PIXEL_ROW(ROW_COEFFICIENTS + r) = as_int(coefficients[coefficientsOffset(pixel, MA_TECHNIQUES) + r]);
 #endif
 #if MA_PRODUCT_TABLES > 0
-  PhongParams brdf;
-  brdf.rhoD = brdfParams[4 * pixel + 0];
-  brdf.rhoS = brdfParams[4 * pixel + 1];
-  brdf.n = brdfParams[4 * pixel + 2];
-  ProductMixture mixture = productMixture(productView(productFloats, productWords), brdf);
+  PhongParams phong;
+  phong.rhoD = brdf[0];
+  phong.rhoS = brdf[1];
+  phong.n = brdf[2];
+  ProductMixture mixture = productMixture(productView(productFloats, productWords), phong);
   PIXEL_ROW(ROW_PRODUCT) = as_int(mixture.diffuse);
   PIXEL_ROW(ROW_PRODUCT + 1) = as_int(mixture.specular);
   PIXEL_ROW(ROW_PRODUCT + 2) = mixture.specularTable;
@@ -182,7 +169,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 }
 
 // The arguments of both sampling kernels: the host binds them once (Sampler::runPixels).
-// --weights optimal: coefficients[pixel·3M + c·M + k] is a_{c,k} (kernels/pixel.h).
+// --weights optimal: a_{c,k} at coefficientsOffset(pixel, M) + c·M + k (kernels/pixel_layout.h).
 #if MA_OPTIMAL_WEIGHTS
 #define MA_OPTIONAL_PARAMETERS , __global const float* coefficients
 #define MA_COEFFICIENTS coefficients
@@ -208,7 +195,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   int pixel = pixelOrder[gid < pixelCount ? gid : pixelCount - 1];
   for (int s = 0; s < SUM_COUNT; ++s) sums[s][lid] = 0;
   // The running sums carry over from earlier stages.
-  for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[pixel * STAT_SLOTS + s];
+  for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[statsOffset(pixel, STAT_SLOTS) + s];
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
   loadPixelRows(pixelRows, MA_LOCAL_SIZE, lid, brdfParams, counts, firstIndex, MA_COEFFICIENTS, productFloats,
                 productWords, stageSamples, pixel);
@@ -265,10 +252,11 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     start += n;
   }
   if (gid < pixelCount) {
-    estimate[3 * pixel + 0] = sums[SUM_R][lid];
-    estimate[3 * pixel + 1] = sums[SUM_G][lid];
-    estimate[3 * pixel + 2] = sums[SUM_B][lid];
-    __global ma_acc* m = moments + pixel * MA_TECHNIQUES * 2;
+    __global ma_acc* e = estimate + estimateOffset(pixel);
+    e[0] = sums[SUM_R][lid];
+    e[1] = sums[SUM_G][lid];
+    e[2] = sums[SUM_B][lid];
+    __global ma_acc* m = moments + momentsOffset(pixel, MA_TECHNIQUES);
     m[0] = sums[SUM_W0][lid];
     m[1] = sums[SUM_WW0][lid];
     m[2] = sums[SUM_W1][lid];
@@ -277,7 +265,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       m[4] = sums[SUM_W2][lid];
       m[5] = sums[SUM_WW2][lid];
     }
-    for (int s = 0; s < STAT_SLOTS; ++s) stats[pixel * STAT_SLOTS + s] = running[s][lid];
+    for (int s = 0; s < STAT_SLOTS; ++s) stats[statsOffset(pixel, STAT_SLOTS) + s] = running[s][lid];
   }
 }
 
@@ -343,10 +331,11 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
     }
   }
   if (lid == 0) {
-    estimate[3 * pixel + 0] = pixelSums.r;
-    estimate[3 * pixel + 1] = pixelSums.g;
-    estimate[3 * pixel + 2] = pixelSums.b;
-    __global ma_acc* m = moments + pixel * MA_TECHNIQUES * 2;
+    __global ma_acc* e = estimate + estimateOffset(pixel);
+    e[0] = pixelSums.r;
+    e[1] = pixelSums.g;
+    e[2] = pixelSums.b;
+    __global ma_acc* m = moments + momentsOffset(pixel, MA_TECHNIQUES);
     m[0] = pixelSums.w0;
     m[1] = pixelSums.ww0;
     m[2] = pixelSums.w1;

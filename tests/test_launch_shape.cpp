@@ -1,12 +1,16 @@
 // The sampling kernel's work-group size per device (host/cl/LaunchShape.h): fake GPU and
 // CPU limits, --local-size overrides, PoCL's real limits, and the local-memory formula
 // against what PoCL reports for the built kernel.
+#include <array>
 #include <catch2/catch.hpp>
 #include <string>
+#include <vector>
 
+#include "Covering.h"
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "TestSize.h"
 #include "cl/LaunchShape.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
@@ -30,7 +34,7 @@ int statSlotsOf(Method method, bool split) {
 }
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
-  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, 0); };
+  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, 10); };
 }
 
 bool hasFp64(const cl::Device& device) {
@@ -41,10 +45,14 @@ bool hasFp64(const cl::Device& device) {
 
 TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, the pixel's rows, the pass counts",
           "[launch]") {
-  CHECK(sampleKernelLocalBytes(8, 0, true, 0) == 8 * (9 * 8 + 11 * 4));
-  CHECK(sampleKernelLocalBytes(256, 15, true, 0) == 256 * (24 * 8 + 11 * 4));
-  CHECK(sampleKernelLocalBytes(64, 6, false, 0) == 64 * (15 * 4 + 11 * 4));
-  CHECK(sampleKernelLocalBytes(8, 20, true, 6) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
+  CHECK(sampleKernelLocalBytes(8, 0, true, 10) == 8 * (9 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(256, 15, true, 10) == 256 * (24 * 8 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(64, 6, false, 10) == 64 * (15 * 4 + 11 * 4));
+  CHECK(sampleKernelLocalBytes(8, 20, true, 16) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
+  // The pixel's rows: BRDF (4), counts (3), first indices (3); 3M coefficients; 3 product.
+  CHECK(kern::pixelRowCount(0, 2, 0) == 10);
+  CHECK(kern::pixelRowCount(1, 2, 0) == 16);
+  CHECK(kern::pixelRowCount(1, 3, 1) == 22);
 }
 
 TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
@@ -110,25 +118,38 @@ TEST_CASE("launch shape: PoCL's CPU device: its limits, and 8 work-items", "[lau
 }
 
 TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
+  // The techniques (the BRDF as one, split, or with the product), the running sums of a
+  // method, the weights and the work-group size each change the kernel's local arrays:
+  // a pairwise covering set of them (tests/Covering.h), every one with
+  // MISALLOC_TEST_SIZE=exhaustive.
+  const Method methods[] = {Method::Equal, Method::Heuristic, Method::Linear};
+  std::vector<std::array<int, 4>> cases;
+  std::vector<Configuration> settings;
+  for (int techniques : {0, 1, 2})
+    for (int method = 0; method < 3; ++method)
+      for (int optimal : {0, 1})
+        for (int localSize : {8, 64}) {
+          cases.push_back({techniques, method, optimal, localSize});
+          settings.push_back({fmt::format("techniques={}", techniques), fmt::format("method={}", method),
+                              fmt::format("optimal={}", optimal), fmt::format("local={}", localSize)});
+        }
+  std::vector<size_t> chosen(cases.size());
+  for (size_t i = 0; i < cases.size(); ++i) chosen[i] = i;
+  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
   const Device& device = testDevice();
   const bool doubleSums = hasFp64(device.device);
-  for (int techniques : {0, 1, 2}) {  // the BRDF as one technique, split, or with the product
+  for (size_t c : chosen) {
+    const auto [techniques, method, optimal, localSize] = cases[c];
     const bool split = techniques == 1, product = techniques == 2;
     Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split, EnvmapSampler::Alias, 0, "plain", product);
-    for (Method method : {Method::Equal, Method::Heuristic, Method::Linear})
-      for (MisWeights weights : {MisWeights::Balance, MisWeights::Optimal}) {
-        AdaptiveOptions options;
-        options.weights = weights;
-        SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 64, options);
-        const int statSlots = HostSampler(scene, config).statSlots();
-        const int optionalRows = (weights == MisWeights::Optimal ? 3 * scene.techniqueCount() : 0) + (product ? 3 : 0);
-        for (int localSize : {8, 64}) {
-          CAPTURE(split, product, methodName(method), misWeightsName(weights), localSize);
-          cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)),
-                            "sampleStage");
-          CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
-                sampleKernelLocalBytes(localSize, statSlots, doubleSums, optionalRows));
-        }
-      }
+    AdaptiveOptions options;
+    options.weights = optimal ? MisWeights::Optimal : MisWeights::Balance;
+    SamplerConfig config = samplerConfigFor(methods[method], Estimator::MultiSample, 64, options);
+    const int statSlots = HostSampler(scene, config).statSlots();
+    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), product);
+    CAPTURE(split, product, methodName(methods[method]), optimal, localSize);
+    cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
+    CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
+          sampleKernelLocalBytes(localSize, statSlots, doubleSums, pixelRows));
   }
 }

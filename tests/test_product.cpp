@@ -229,3 +229,15 @@ TEST_CASE("the product technique with split lobes is refused: 4 techniques", "[p
   o.envmapPdf = parseEnvmapPdf("plain");
   CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --split-brdf: not implemented"));
 }
+
+TEST_CASE("BRDF sampling alone gives the product technique no samples: technique 2 is the product, not a lobe",
+          "[product][roles]") {
+  const Scene product =
+      smallScene("constant", "uniform:0.5,0.5,10", 4, 4, false, EnvmapSampler::Alias, 0, "plain", true);
+  CHECK(product.techniqueNames() == std::vector<std::string>{"envmap", "brdf", "product"});
+  CHECK(methodCounts(product, Method::Brdf, 16, 0) == std::vector<int>{0, 16, 0});
+  // With the lobes split, brdf shares its samples between them by their albedos.
+  const Scene split = smallScene("constant", "uniform:0.5,0.5,10", 4, 4, true);
+  CHECK(split.techniqueNames() == std::vector<std::string>{"envmap", "diffuse", "specular"});
+  CHECK(methodCounts(split, Method::Brdf, 16, 0) == std::vector<int>{0, 8, 8});
+}

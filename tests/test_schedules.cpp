@@ -143,19 +143,26 @@ TEST_CASE("the refused schedules are those that would be biased", "[unbiased][sc
   CHECK_THROWS_AS(requireValidRun(compensated, Method::Equal, Estimator::OneSample, 1, {}), InputError);
   CHECK_THROWS_AS(requireValidRun(compensated, Method::Oracle, Estimator::MultiSample, 1, {}), InputError);
   // The coverage rule itself.
-  CHECK(coversIntegrand(0b01, 2, EnvmapPdf{}, Estimator::MultiSample));
-  CHECK_FALSE(coversIntegrand(0b01, 2, compensated.envmapPdf, Estimator::MultiSample));
-  CHECK(coversIntegrand(0b10, 2, compensated.envmapPdf, Estimator::OneSample));
-  CHECK_FALSE(coversIntegrand(0b100, 3, EnvmapPdf{}, Estimator::MultiSample));
+  auto techniques = [](int M, const EnvmapPdf& pdf, bool withProduct = false) {
+    SceneOptions options;
+    options.splitBrdf = M == 3 && !withProduct;
+    options.product = withProduct;
+    options.envmapPdf = pdf;
+    return options;
+  };
+  CHECK(coversIntegrand(0b01, techniques(2, EnvmapPdf{}), Estimator::MultiSample));
+  CHECK_FALSE(coversIntegrand(0b01, techniques(2, compensated.envmapPdf), Estimator::MultiSample));
+  CHECK(coversIntegrand(0b10, techniques(2, compensated.envmapPdf), Estimator::OneSample));
+  CHECK_FALSE(coversIntegrand(0b100, techniques(3, EnvmapPdf{}), Estimator::MultiSample));
   // The product technique covers wherever the map is lit, whatever the envmap pdf.
-  CHECK(coversIntegrand(0b100, 3, compensated.envmapPdf, Estimator::MultiSample, true));
-  CHECK(coversIntegrand(0b100, 3, compensated.envmapPdf, Estimator::OneSample, true));
-  CHECK_FALSE(coversIntegrand(0b100, 3, EnvmapPdf{}, Estimator::CountIndependent, true));
-  CHECK(coversIntegrand(0b010, 3, compensated.envmapPdf, Estimator::MultiSample));
-  CHECK_FALSE(coversIntegrand(0b10, 2, EnvmapPdf{}, Estimator::CountIndependent));
-  CHECK(coversIntegrand(0b11, 2, EnvmapPdf{}, Estimator::CountIndependent));
+  CHECK(coversIntegrand(0b100, techniques(3, compensated.envmapPdf, true), Estimator::MultiSample));
+  CHECK(coversIntegrand(0b100, techniques(3, compensated.envmapPdf, true), Estimator::OneSample));
+  CHECK_FALSE(coversIntegrand(0b100, techniques(3, EnvmapPdf{}, true), Estimator::CountIndependent));
+  CHECK(coversIntegrand(0b010, techniques(3, compensated.envmapPdf), Estimator::MultiSample));
+  CHECK_FALSE(coversIntegrand(0b10, techniques(2, EnvmapPdf{}), Estimator::CountIndependent));
+  CHECK(coversIntegrand(0b11, techniques(2, EnvmapPdf{}), Estimator::CountIndependent));
   // Resampling draws its candidates from the envmap pdf alone.
-  CHECK(coversIntegrand(0b01, 2, EnvmapPdf{}, Estimator::Resampled));
-  CHECK_FALSE(coversIntegrand(0b01, 2, compensated.envmapPdf, Estimator::Resampled));
-  CHECK_FALSE(coversIntegrand(0b10, 2, EnvmapPdf{}, Estimator::Resampled));
+  CHECK(coversIntegrand(0b01, techniques(2, EnvmapPdf{}), Estimator::Resampled));
+  CHECK_FALSE(coversIntegrand(0b01, techniques(2, compensated.envmapPdf), Estimator::Resampled));
+  CHECK_FALSE(coversIntegrand(0b10, techniques(2, EnvmapPdf{}), Estimator::Resampled));
 }

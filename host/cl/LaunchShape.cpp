@@ -8,16 +8,10 @@
 #include <vector>
 
 #include "Error.h"
+#include "KernelCode.h"
 
 namespace misalloc {
 namespace {
-
-// kernels/sample.cl's SUM_COUNT: R, G, B, and per technique Σ w and Σ w².
-constexpr size_t kSampleSums = 9;
-// kernels/sample.cl's ROW_COEFFICIENTS: the pixel's BRDF, BRDF bin, counts and first
-// indices, 32-bit words read once before the sample loop (the optimal weights'
-// coefficients follow them).
-constexpr size_t kPixelRows = 10;
 
 // PoCL vectorises a work-group across 8 work-items fastest (docs/pocl.md, rule 4).
 constexpr int kCpuLocalSize = 8;
@@ -68,10 +62,9 @@ DeviceLimits deviceLimits(const cl::Device& device) {
   return limits;
 }
 
-size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int optionalRows) {
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int pixelRows) {
   const size_t acc = doubleSums ? sizeof(double) : sizeof(float);
-  return size_t(localSize) *
-         ((kSampleSums + size_t(statSlots)) * acc + (kPixelRows + size_t(optionalRows) + 1) * sizeof(cl_int));
+  return size_t(localSize) * ((kern::SUM_COUNT + size_t(statSlots)) * acc + (size_t(pixelRows) + 1) * sizeof(cl_int));
 }
 
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,

@@ -31,12 +31,11 @@ DeviceLimits deviceLimits(const cl::Device& device);
 
 // The local memory of sampleStage at this work-group size: its sums and running sums
 // (`statSlots`, StageStatistics::statSlots()), in double where `doubleSums` (ma_acc,
-// kernels/common.h) else float, and per work-item its pixel's rows and pass count. With no running sums the kernel
-// declares a one-row placeholder that it never touches: PoCL and clang's nvptx64
-// back end both drop it, so it is not counted. `optionalRows`: the pixel's rows that
-// only some kernels have: the optimal weights' coefficients (3M with --weights optimal)
-// and the product technique's mixture (3 with --product).
-size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int optionalRows);
+// kernels/common.h) else float, and per work-item its pixel's rows (`pixelRows`,
+// kern::pixelRowCount) and pass count. With no running sums the kernel declares a
+// one-row placeholder that it never touches: PoCL and clang's nvptx64 back end both
+// drop it, so it is not counted.
+size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int pixelRows);
 
 struct LaunchShape {
   int localSize = 0;

@@ -80,9 +80,9 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
       counts[0] = spp;
       break;
     case Method::Brdf:
-      if (M == 2) {
+      if (scene.options.techniqueRole(1) == kern::ROLE_BRDF) {
         counts[1] = spp;
-      } else {
+      } else {  // the lobes, split
         const PhongParameters& p = scene.grid.pixels[pixel];
         double albedo = p.rhoD + p.rhoS;
         counts[1] = albedo > 0 ? int(std::lround(spp * p.rhoD / albedo)) : spp;

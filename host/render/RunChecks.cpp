@@ -5,54 +5,66 @@
 #include <algorithm>
 
 #include "Error.h"
+#include "KernelCode.h"
 
 namespace misalloc {
 namespace {
 
-constexpr unsigned kEnvmapTechnique = 1u << 0;
-// The BRDF (M = 2) or its diffuse lobe (M = 3): either covers every direction where the
-// BRDF is non-zero.
-constexpr unsigned kCoveringBrdfTechnique = 1u << 1;
-// The product technique (--product): its plain envmap share (kernels/product.h) covers
-// every direction where the map is lit, whatever the envmap technique's pdf.
-constexpr unsigned kProductTechnique = 1u << 2;
-
 unsigned allTechniques(int M) { return (1u << M) - 1; }
+
+// The techniques of `scene` whose role is one of `roles`.
+unsigned techniquesOf(const SceneOptions& scene, std::initializer_list<int> roles) {
+  unsigned set = 0;
+  for (int k = 0; k < scene.techniqueCount(); ++k)
+    if (std::find(roles.begin(), roles.end(), scene.techniqueRole(k)) != roles.end()) set |= 1u << k;
+  return set;
+}
+
+// Whether a technique covers, alone, every direction where the integrand is non-zero:
+// BRDF sampling and its diffuse lobe wherever the BRDF is non-zero, the product technique
+// wherever the map is lit (its plain envmap share, kernels/product.h), the envmap's with
+// the plain pdf alone. The specular lobe covers only its own cone.
+bool coversAlone(int role, const EnvmapPdf& pdf) {
+  return role == kern::ROLE_BRDF || role == kern::ROLE_DIFFUSE || role == kern::ROLE_PRODUCT ||
+         (role == kern::ROLE_ENVMAP && pdf.plain());
+}
 
 // The techniques a fixed split samples in every pixel that needs them: `envmap`, `ris`
 // and `brdf` their own, `equal` the first min(spp, M) (methodCounts hands out the
 // remainder from technique 0 on).
-unsigned fixedSplitTechniques(Method method, int M, int spp) {
+unsigned fixedSplitTechniques(const SceneOptions& scene, Method method, int spp) {
   switch (method) {
     case Method::Envmap:
     case Method::Ris:
-      return kEnvmapTechnique;
+      return techniquesOf(scene, {kern::ROLE_ENVMAP});
     case Method::Brdf:  // with lobes: the diffuse one wherever its albedo is non-zero (methodCounts)
-      return kCoveringBrdfTechnique;
+      return techniquesOf(scene, {kern::ROLE_BRDF, kern::ROLE_DIFFUSE});
     default:
-      return allTechniques(std::min(spp, M));
+      return allTechniques(std::min(spp, scene.techniqueCount()));
   }
 }
 
 // An allocated stage of `samples` samples: all techniques once the floor can give each
 // one, else any single technique.
-bool allocatedStageCovers(int samples, int M, const EnvmapPdf& pdf, Estimator estimator, bool product) {
-  if (samples >= M) return coversIntegrand(allTechniques(M), M, pdf, estimator, product);
+bool allocatedStageCovers(const SceneOptions& scene, int samples, Estimator estimator) {
+  const int M = scene.techniqueCount();
+  if (samples >= M) return coversIntegrand(allTechniques(M), scene, estimator);
   for (int k = 0; k < M; ++k)
-    if (!coversIntegrand(1u << k, M, pdf, estimator, product)) return false;
+    if (!coversIntegrand(1u << k, scene, estimator)) return false;
   return true;
 }
 
-std::string biasReason(const EnvmapPdf& pdf, Estimator estimator, int M) {
+std::string biasReason(const SceneOptions& scene, Estimator estimator) {
   if (estimator == Estimator::CountIndependent)
     return "the count-independent estimator ([SHS16] eq. 26) needs a sample of every technique in every stage";
-  if (!pdf.plain())
+  if (!scene.envmapPdf.plain())
     return fmt::format(
         "the {} envmap pdf is zero where the radiance is low, so BRDF sampling must take a sample in "
         "every stage",
-        envmapPdfName(pdf));
-  return M == 3 ? "the specular lobe alone misses the diffuse lobe, so every stage needs a sample of each technique"
-                : "every stage needs a sample of each technique";
+        envmapPdfName(scene.envmapPdf));
+  return techniquesOf(scene, {kern::ROLE_SPECULAR}) != 0
+             ? "the specular lobe alone misses the diffuse lobe, so every stage needs a sample of each technique"
+             : "every stage needs a sample of each technique";
 }
 
 void requireCoveredStages(const SceneOptions& scene, Method method, Estimator estimator, int spp,
@@ -68,22 +80,22 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
         traits.name, envmapPdfName(pdf),
         traits.estimator == Estimator::Resampled ? "resampling envmap candidates ([TCE05])" : "envmap sampling alone"));
   if (traits.split == Split::Fixed) {
-    if (coversIntegrand(fixedSplitTechniques(method, M, spp), M, pdf, estimator, scene.product)) return;
+    if (coversIntegrand(fixedSplitTechniques(scene, method, spp), scene, estimator)) return;
     throw InputError(
         fmt::format("--spp {} with --method {}{}: the split leaves a technique without samples, and {}; "
                     "raise --spp",
                     spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf),
-                    biasReason(pdf, estimator, M)));
+                    biasReason(scene, estimator)));
   }
   std::vector<int> sizes{spp};
   if (traits.split == Split::Staged) sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
   const int smallest = *std::min_element(sizes.begin(), sizes.end());
-  if (!allocatedStageCovers(smallest, M, pdf, traits.estimator, scene.product))
+  if (!allocatedStageCovers(scene, smallest, traits.estimator))
     throw InputError(fmt::format(
         "--spp {} with --method {}{}: a stage of {} sample(s) cannot give each of the {} techniques one, and {}; "
         "raise --spp{}",
         spp, methodName(method), pdf.plain() ? "" : " and --envmap-pdf " + envmapPdfName(pdf), smallest, M,
-        biasReason(pdf, traits.estimator, M), traits.split == Split::Staged ? " or lower --stages" : ""));
+        biasReason(scene, traits.estimator), traits.split == Split::Staged ? " or lower --stages" : ""));
 }
 
 // [Kon19]'s optimal weights replace the multi-sample balance heuristic of a method's
@@ -130,12 +142,13 @@ bool takesOptimalWeights(Method method, Estimator estimator) {
                            : method == Method::Equal && estimator == Estimator::MultiSample;
 }
 
-bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator, bool product) {
-  if (estimator == Estimator::CountIndependent) return sampled == allTechniques(techniqueCount);
-  if (estimator == Estimator::Resampled) return pdf.plain() && (sampled & kEnvmapTechnique);
-  if (pdf.plain() && (sampled & kEnvmapTechnique)) return true;
-  if (product && (sampled & kProductTechnique)) return true;
-  return (sampled & kCoveringBrdfTechnique) != 0;
+bool coversIntegrand(unsigned sampled, const SceneOptions& scene, Estimator estimator) {
+  if (estimator == Estimator::CountIndependent) return sampled == allTechniques(scene.techniqueCount());
+  if (estimator == Estimator::Resampled)
+    return scene.envmapPdf.plain() && (sampled & techniquesOf(scene, {kern::ROLE_ENVMAP})) != 0;
+  for (int k = 0; k < scene.techniqueCount(); ++k)
+    if ((sampled >> k & 1u) && coversAlone(scene.techniqueRole(k), scene.envmapPdf)) return true;
+  return false;
 }
 
 void requireValidRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,

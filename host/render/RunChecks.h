@@ -15,10 +15,9 @@ namespace misalloc {
 // only its own cone. The count-independent weights ([SHS16] eq. 26) give each technique
 // a term that only its own samples estimate: every technique must be sampled. Resampling
 // ([TCE05]) draws its candidates from the envmap pdf alone, which must then cover it.
-// With `product`, technique 2 is the product technique (--product), which covers it
-// wherever the map is lit, whatever the envmap pdf.
-bool coversIntegrand(unsigned sampled, int techniqueCount, const EnvmapPdf& pdf, Estimator estimator,
-                     bool product = false);
+// The product technique (--product) covers it wherever the map is lit, whatever the
+// envmap pdf. The techniques' roles and the envmap pdf are the scene's.
+bool coversIntegrand(unsigned sampled, const SceneOptions& scene, Estimator estimator);
 
 // Whether a run of `method` with `estimator` (a fixed split's) has the multi-sample
 // balance heuristic whose weights [Kon19]'s optimal weights replace (--weights optimal):

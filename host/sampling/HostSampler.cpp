@@ -45,7 +45,7 @@ namespace {
 kern::OptimalCoefficients optimalCoefficients(const StagePlan& plan, int pixel, int M) {
   kern::OptimalCoefficients a{};
   if (plan.optimalCoefficients.empty()) return a;
-  const float* row = plan.optimalCoefficients.data() + size_t(pixel) * 3 * M;
+  const float* row = plan.optimalCoefficients.data() + kern::coefficientsOffset(pixel, M);
   for (int ch = 0; ch < 3; ++ch)
     for (int k = 0; k < M; ++k) a.a[ch][k] = row[ch * M + k];
   return a;
@@ -79,8 +79,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   const int slots = plan.keepStatistics ? statSlots() : 0;
   const int perTechnique = MA_STATS_PER_TECHNIQUE(int(config.statsMask), M);
   StageResult result;
-  result.rgb.assign(size_t(range.size()) * 3, 0.0);
-  result.moments.assign(size_t(range.size()) * M * 2, 0.0);
+  result.rgb.assign(kern::estimateOffset(range.size()), 0.0);
+  result.moments.assign(kern::momentsOffset(range.size(), M), 0.0);
   auto start = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(dynamic, 64)
   for (int pixel = range.begin; pixel < range.end; ++pixel) {
@@ -99,7 +99,7 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
                               config_.estimator == Estimator::CountIndependent, config_.risCandidates);
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     kern::PixelSums sums = kern::zeroPixelSums();
-    double* running = stats_.data() + size_t(pixel) * slots;
+    double* running = stats_.data() + kern::statsOffset(pixel, slots);
     for (int j = 0; j < plan.stageSamples; ++j) {
       kern::SampleContribution s = kern::takeStageSample(pixelTs, pixelEnv, b, c, j, uint32_t(seed),
                                                          uint32_t(seed >> 32), uint32_t(scene_.firstPixel + pixel));
@@ -119,13 +119,13 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
               kern::storedPdf(s, columns.shareColumns, l);
       }
     }
-    const size_t row = size_t(pixel - range.begin);
-    double* rgb = result.rgb.data() + row * 3;
+    const int row = pixel - range.begin;
+    double* rgb = result.rgb.data() + kern::estimateOffset(row);
     rgb[0] = sums.r;
     rgb[1] = sums.g;
     rgb[2] = sums.b;
     const double moments[6] = {sums.w0, sums.ww0, sums.w1, sums.ww1, sums.w2, sums.ww2};
-    std::copy(moments, moments + 2 * M, result.moments.data() + row * M * 2);
+    std::copy(moments, moments + 2 * M, result.moments.data() + kern::momentsOffset(row, M));
   }
   result.kernelSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   share_.pixelStages += range.size();

@@ -72,7 +72,7 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
   productFloats = upload(device, scene.productTables.floats);
   productWords = upload(device, scene.productTables.words);
   std::vector<float> params;
-  params.reserve(scene.grid.pixels.size() * 4);
+  params.reserve(size_t(kern::brdfOffset(int(scene.grid.pixels.size()))));
   for (std::size_t p = 0; p < scene.grid.pixels.size(); ++p) {
     const PhongParameters& b = scene.grid.pixels[p];
     params.insert(params.end(), {b.rhoD, b.rhoS, b.n, t.hasBank() ? float(t.brdfBinOfPixel[p]) : 0.0f});
@@ -91,7 +91,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       [&](int size) {
         return sampleKernelLocalBytes(
             size, statSlots(), doubleSums_,
-            (config.optimalWeights ? 3 * scene.techniqueCount() : 0) + (scene.productTables.enabled() ? 3 : 0));
+            kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.enabled()));
       },
       localSize);
   localSize_ = shape.localSize;
@@ -118,14 +118,16 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   samples_ = config.sampleCapacity > 0
                  ? upload(device, withSpareRecord(emptyStoredSamples(scene, config), scene, config), CL_MEM_READ_WRITE)
                  : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
-  const size_t pixels = size_t(scene.pixelCount()), M = size_t(scene.techniqueCount());
-  counts_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(int32_t));
-  firstIndex_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * M * sizeof(uint32_t));
-  pixelOrder_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * sizeof(int32_t));
-  rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * 3 * accSize);
-  moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, pixels * M * 2 * accSize);
+  // Each buffer's size is the offset of the pixel past the last (kernels/pixel_layout.h).
+  const int pixels = scene.pixelCount(), M = scene.techniqueCount();
+  counts_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, size_t(kern::countsOffset(pixels, M)) * sizeof(int32_t));
+  firstIndex_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, size_t(kern::countsOffset(pixels, M)) * sizeof(uint32_t));
+  pixelOrder_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, size_t(pixels) * sizeof(int32_t));
+  rgb_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, size_t(kern::estimateOffset(pixels)) * accSize);
+  moments_ = cl::Buffer(device.context, CL_MEM_WRITE_ONLY, size_t(kern::momentsOffset(pixels, M)) * accSize);
   if (config.optimalWeights)
-    coefficients_ = cl::Buffer(device.context, CL_MEM_READ_ONLY, pixels * 3 * M * sizeof(float));
+    coefficients_ =
+        cl::Buffer(device.context, CL_MEM_READ_ONLY, size_t(kern::coefficientsOffset(pixels, M)) * sizeof(float));
   share_.name = device.name();
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a stage of no samples, not inside the first timed stage.
@@ -145,7 +147,7 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   const int M = scene_.techniqueCount();
   StageResult result;
   if (range.size() == 0) return result;
-  const size_t rows = size_t(range.size()) * M, firstRow = size_t(range.begin) * M;
+  const size_t rows = kern::countsOffset(range.size(), M), firstRow = kern::countsOffset(range.begin, M);
   const cl::CommandQueue& queue = device_.queue;
   queue.enqueueWriteBuffer(counts_, CL_FALSE, firstRow * sizeof(int32_t), rows * sizeof(int32_t),
                            plan.counts.data() + firstRow);
@@ -179,8 +181,8 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   auto read = [&](const cl::Buffer& b, size_t first, size_t n) {
     return doubleSums_ ? readSums<double>(device_, b, first, n) : readSums<float>(device_, b, first, n);
   };
-  result.rgb = read(rgb_, size_t(range.begin) * 3, size_t(range.size()) * 3);
-  result.moments = read(moments_, firstRow * 2, rows * 2);
+  result.rgb = read(rgb_, kern::estimateOffset(range.begin), kern::estimateOffset(range.size()));
+  result.moments = read(moments_, kern::momentsOffset(range.begin, M), kern::momentsOffset(range.size(), M));
   share_.pixelStages += range.size();
   share_.samples += (long long)range.size() * plan.stageSamples;
   share_.tiles += 1;
@@ -210,11 +212,11 @@ void Sampler::loadStoredSamples(const std::vector<float>& samples) {
 std::vector<DeviceShare> Sampler::deviceShares() const { return {share_}; }
 
 void Sampler::writeCoefficients(const StagePlan& plan, PixelRange range) {
-  const size_t perPixel = size_t(3) * scene_.techniqueCount(), values = size_t(range.size()) * perPixel;
+  const int M = scene_.techniqueCount();
+  const size_t first = kern::coefficientsOffset(range.begin, M), values = kern::coefficientsOffset(range.size(), M);
   const std::vector<float> zeros(plan.optimalCoefficients.empty() ? values : 0, 0.0f);
-  const float* rows = zeros.empty() ? plan.optimalCoefficients.data() + size_t(range.begin) * perPixel : zeros.data();
-  device_.queue.enqueueWriteBuffer(coefficients_, CL_TRUE, size_t(range.begin) * perPixel * sizeof(float),
-                                   values * sizeof(float), rows);
+  const float* rows = zeros.empty() ? plan.optimalCoefficients.data() + first : zeros.data();
+  device_.queue.enqueueWriteBuffer(coefficients_, CL_TRUE, first * sizeof(float), values * sizeof(float), rows);
 }
 
 void Sampler::forgetStages() {

@@ -9,15 +9,23 @@
 #include <filesystem>
 
 #include "Error.h"
+#include "KernelCode.h"
 #include "distributions/BankCache.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
 
+int SceneOptions::techniqueRole(int technique) const { return kern::techniqueRole(splitBrdf, product, technique); }
+
+const char* techniqueRoleName(int role) {
+  static const char* const names[kern::ROLE_COUNT] = {"envmap", "brdf", "diffuse", "specular", "product"};
+  return names[role];
+}
+
 std::vector<std::string> Scene::techniqueNames() const {
-  if (options.splitBrdf) return {"envmap", "diffuse", "specular"};
-  if (options.product) return {"envmap", "brdf", "product"};
-  return {"envmap", "brdf"};
+  std::vector<std::string> names;
+  for (int k = 0; k < techniqueCount(); ++k) names.push_back(techniqueRoleName(options.techniqueRole(k)));
+  return names;
 }
 
 namespace {

@@ -27,7 +27,13 @@ struct SceneOptions {
   // M: envmap sampling and BRDF sampling, then either of the BRDF's lobes split, or the
   // product technique.
   int techniqueCount() const { return splitBrdf || product ? 3 : 2; }
+  // What technique k samples: kern::ROLE_ENVMAP, ROLE_BRDF, ... (kernels/estimator.h).
+  int techniqueRole(int technique) const;
 };
+
+// A role's name, as reports and α maps name the technique: envmap, brdf, diffuse,
+// specular, product.
+const char* techniqueRoleName(int role);
 
 // Everything the sampling kernel reads, built once per run.
 struct Scene {

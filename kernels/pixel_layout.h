@@ -1,0 +1,55 @@
+// Where a pixel's values lie, defined once: in the sampling kernels' per-pixel buffers
+// and in the rows of local memory that kernels/sample.cl reads them into. The host sizes
+// its buffers and local memory and reads its results by the same definitions
+// (host/sampling/Sampler.cpp, host/sampling/HostSampler.cpp, host/cl/LaunchShape.cpp).
+#include "namespace_check.h"
+#ifndef MA_PIXEL_LAYOUT_H
+#define MA_PIXEL_LAYOUT_H
+#include "common.h"
+
+// sampleStage's sums, one row of local memory per sum: R, G, B, then per technique Σ w
+// and Σ w².
+enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
+
+// What a pixel's samples share, one 32-bit word per row: its BRDF, BRDF bin, counts and
+// first sample indices; then, with --weights optimal, the coefficients a_{c,k} at row
+// ROW_COEFFICIENTS + c·M + k; then, with --product, its ProductMixture (diffuse,
+// specular, specular table).
+enum {
+  ROW_RHO_D,
+  ROW_RHO_S,
+  ROW_N,
+  ROW_BRDF_BIN,
+  ROW_N0,
+  ROW_N1,
+  ROW_N2,
+  ROW_FIRST0,
+  ROW_FIRST1,
+  ROW_FIRST2,
+  ROW_COEFFICIENTS
+};
+// Macros, for the kernel's local arrays; pixelRowCount for the host.
+#define MA_ROW_PRODUCT(optimalWeights, techniqueCount) \
+  (ROW_COEFFICIENTS + ((optimalWeights) ? 3 * (techniqueCount) : 0))
+#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product) \
+  (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
+
+MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product) {
+  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product);
+}
+
+// The per-pixel buffers, pixel p's first element. BRDF words: ρ_d, ρ_s, n, BRDF bin.
+#define MA_BRDF_WORDS 4
+MA_FN int brdfOffset(int pixel) { return MA_BRDF_WORDS * pixel; }
+// The estimate: R, G, B.
+MA_FN int estimateOffset(int pixel) { return 3 * pixel; }
+// The moments: Σ w, Σ w² per technique.
+MA_FN int momentsOffset(int pixel, int techniqueCount) { return 2 * techniqueCount * pixel; }
+// The optimal weights' coefficients: a_{c,k} at c·M + k.
+MA_FN int coefficientsOffset(int pixel, int techniqueCount) { return 3 * techniqueCount * pixel; }
+// The running sums: `slots` per pixel (MA_STATS_PER_TECHNIQUE per technique, kernels/stats.h).
+MA_FN int statsOffset(int pixel, int slots) { return slots * pixel; }
+// The counts and first sample indices: technique k's at k.
+MA_FN int countsOffset(int pixel, int techniqueCount) { return techniqueCount * pixel; }
+
+#endif
