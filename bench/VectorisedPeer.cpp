@@ -16,11 +16,11 @@ struct TechniqueSums {
   double r = 0, g = 0, b = 0, w = 0, ww = 0;
 };
 
-// What the pass of one pixel reads: the scene's views, the pixel's BRDF, counts and key.
+// What the pass of one pixel reads: the scene's views, the pixel's shading point, counts and key.
 struct PixelPass {
   kern::EnvmapView env;
   kern::TechniqueSet ts;
-  kern::PhongParams brdf;
+  kern::ShadingPoint point;
   kern::StageCounts counts;
   uint32_t seedLo, seedHi, pixelKey;
 };
@@ -47,13 +47,13 @@ SampleTerm brdfTerm(const PixelPass& p, uint32_t index) {
   const kern::MaRandom4 rnd = kern::philoxDraw(p.seedLo, p.seedHi, p.pixelKey, 1u, index);
   const float u1 = kern::uniformFloat(rnd.v[1]), u2 = kern::uniformFloat(rnd.v[2]);
   const kern::MaVec3 diffuse = kern::sampleDiffuse(u1, u2);
-  const kern::MaVec3 specular = kern::sampleSpecular(p.brdf, p.ts.mirror, u1, u2);
-  const bool isDiffuse = kern::uniformFloat(rnd.v[0]) < kern::diffuseLobeWeight(p.brdf);
+  const kern::MaVec3 specular = kern::sampleSpecular(p.point.brdf, p.point.mirror, u1, u2);
+  const bool isDiffuse = kern::uniformFloat(rnd.v[0]) < kern::diffuseLobeWeight(p.point.brdf);
   kern::TechniqueSample drawn;
   drawn.wi = kern::makeVec3(isDiffuse ? diffuse.x : specular.x, isDiffuse ? diffuse.y : specular.y,
                             isDiffuse ? diffuse.z : specular.z);
   drawn.texel = 0;
-  const kern::SampleValue v = kern::evaluateSample(p.ts, p.env, p.brdf, 1, drawn);
+  const kern::SampleValue v = kern::evaluateSample(p.ts, p.env, p.point, 1, drawn);
   float alpha[MA_MAX_TECHNIQUES];
   kern::stageFractions(p.counts, alpha);
   const float mixture = kern::mixturePdf(2, alpha, v.pdfs), N = float(p.counts.stageSamples);
@@ -80,7 +80,7 @@ TechniqueSums techniquePass(PixelPass p) {
   for (int j = 0; j < n; ++j) {
     SampleTerm s;
     if constexpr (Technique == 0) {
-      const kern::SampleContribution c = kern::takeTechniqueSample(p.ts, p.env, p.brdf, p.counts, 0,
+      const kern::SampleContribution c = kern::takeTechniqueSample(p.ts, p.env, p.point, p.counts, 0,
                                                                    first + uint32_t(j), p.seedLo, p.seedHi, p.pixelKey);
       s = {c.r, c.g, c.b, c.w};
     } else {
@@ -137,7 +137,6 @@ StageResult VectorisedPeer::run(const StagePlan& plan, uint64_t seed) const {
   const int pixels = scene_.pixelCount();
   PixelPass shared{};
   shared.env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
-  shared.ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
   shared.seedLo = uint32_t(seed);
   shared.seedHi = uint32_t(seed >> 32);
   StageResult result;
@@ -149,10 +148,7 @@ StageResult VectorisedPeer::run(const StagePlan& plan, uint64_t seed) const {
 #pragma omp parallel for schedule(dynamic, 64)
   for (int pixel = 0; pixel < pixels; ++pixel) {
     PixelPass p = shared;
-    const PhongParameters& brdf = scene_.grid.pixels[pixel];
-    p.brdf.rhoD = brdf.rhoD;
-    p.brdf.rhoS = brdf.rhoS;
-    p.brdf.n = brdf.n;
+    p.point = makeShadingPoint(scene_, pixel);
     p.counts = kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, 2, plan.stageSamples, 0, 0, 0);
     p.pixelKey = uint32_t(scene_.firstPixel + pixel);
     passes(p, result.rgb.data() + size_t(pixel) * 3, result.moments.data() + size_t(pixel) * 4);

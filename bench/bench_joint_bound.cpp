@@ -113,10 +113,7 @@ std::vector<ProbeSample> probePixel(const Scene& scene, kern::EnvmapView env, in
   ts.techniqueCount = 2;
   ts.splitBrdf = 0;
   ts.product.tables = 0;
-  ts.mirror = kern::makeVec3(scene.mirror[0], scene.mirror[1], scene.mirror[2]);
-  const PhongParameters& p = scene.grid.pixels[pixel];
-  kern::PhongParams b;
-  b.rhoD = p.rhoD, b.rhoS = p.rhoS, b.n = p.n;
+  const kern::ShadingPoint sp = makeShadingPoint(scene, pixel);
   env.brdfBin = scene.tables.brdfBinOfPixel[pixel];
   const int probeShare = nearestShare(env, 0.5);
   std::vector<ProbeSample> samples;
@@ -124,8 +121,8 @@ std::vector<ProbeSample> probePixel(const Scene& scene, kern::EnvmapView env, in
     int technique = i % 2;
     env.bankEntry = env.brdfBin * env.bankShares + probeShare;
     kern::MaRandom4 rnd = kern::philoxDraw(stream, 0x6a6f696eu, uint32_t(pixel), uint32_t(technique), uint32_t(i));
-    kern::TechniqueSample t = kern::sampleTechnique(ts, env, b, technique, rnd, 0.0f);
-    kern::SampleValue v = kern::evaluateSample(ts, env, b, technique, t);
+    kern::TechniqueSample t = kern::sampleTechnique(ts, env, sp, technique, rnd, 0.0f);
+    kern::SampleValue v = kern::evaluateSample(ts, env, sp, technique, t);
     int texel = technique == 0 ? t.texel : kern::texelOfDirection(env, t.wi);
     float sinTheta = std::sqrt(t.wi.x * t.wi.x + t.wi.y * t.wi.y);
     ProbeSample s;

@@ -25,10 +25,17 @@ MA_FN int techniqueRole(int splitBrdf, int product, int technique) {
   return product ? ROLE_PRODUCT : ROLE_SPECULAR;
 }
 
+// The point a pixel shades, as every technique's sample and pdf read it (pbrt-v4's
+// LightSampleContext, Mitsuba 3's Interaction): its BRDF and the mirror direction of its
+// view ω_o, in its shading frame, where the normal is z.
+typedef struct {
+  PhongParams brdf;
+  MaVec3 mirror;
+} ShadingPoint;
+
 typedef struct {
   int techniqueCount;             // M
   int splitBrdf;                  // M = 3: the BRDF's lobes are techniques of their own
-  MaVec3 mirror;                  // mirror direction of ω_o about the normal (z)
   ProductView product;            // product.tables > 0: technique 2 is the product technique
   ProductMixture productMixture;  // the pixel's (productMixture)
   int sharePdfs;                  // 1: evaluateSample also gives the envmap's pdf under every share of the bank
@@ -51,7 +58,7 @@ MA_FN int drawsTexel(TechniqueSet ts, int technique) {
 }
 
 // mixtureU: the product technique's choice of table (sampleProduct); unused by the others.
-MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongParams b, int technique, MaRandom4 rnd,
+MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, ShadingPoint sp, int technique, MaRandom4 rnd,
                                       float mixtureU) {
   TechniqueSample s;
   s.texel = 0;
@@ -62,26 +69,26 @@ MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, PhongPara
     s.wi = e.w;
     s.texel = e.texel;
   } else if (role == ROLE_BRDF) {
-    s.wi = sampleBrdf(b, ts.mirror, rnd);
+    s.wi = sampleBrdf(sp.brdf, sp.mirror, rnd);
   } else {
     float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
-    s.wi = role == ROLE_DIFFUSE ? sampleDiffuse(u1, u2) : sampleSpecular(b, ts.mirror, u1, u2);
+    s.wi = role == ROLE_DIFFUSE ? sampleDiffuse(u1, u2) : sampleSpecular(sp.brdf, sp.mirror, u1, u2);
   }
   return s;
 }
 
 // p_k(ω_i) of every technique (0 past the last), given the envmap's pdf and the Phong
 // lobe at ω_i, which lies in texel t at sin θ = sinTheta.
-MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, PhongParams b, MaVec3 wi, int t, float sinTheta,
+MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, ShadingPoint sp, MaVec3 wi, int t, float sinTheta,
                          float envmapPdf, float lobe, float* pdfs) {
   MA_UNROLL
   for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) {
     int role = roleOf(ts, k);
     pdfs[k] = k >= ts.techniqueCount  ? 0.0f
               : role == ROLE_ENVMAP   ? envmapPdf
-              : role == ROLE_BRDF     ? brdfPdf(b, wi, lobe)
+              : role == ROLE_BRDF     ? brdfPdf(sp.brdf, wi, lobe)
               : role == ROLE_DIFFUSE  ? diffusePdf(wi)
-              : role == ROLE_SPECULAR ? specularPdf(b, lobe)
+              : role == ROLE_SPECULAR ? specularPdf(sp.brdf, lobe)
                                       : productPdf(env, ts.product, ts.productMixture, t, envmapPdf, sinTheta);
   }
 }
@@ -103,19 +110,19 @@ typedef struct {
 // f and every p_k at the direction that `technique` drew, in the texel it drew (as
 // sampleEnvmap says why) or the one that holds it. A constant `technique` folds the
 // envmap lookup to one of its two cases.
-MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, PhongParams b, int technique,
+MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, ShadingPoint sp, int technique,
                                  TechniqueSample sample) {
   MaVec3 wi = sample.wi;
   int texel = drawsTexel(ts, technique) ? sample.texel : texelOfDirection(env, wi);
   EnvmapHit hit = envmapTexelHit(env, texel, wi);
   float cosTheta = ma_max(wi.z, 0.0f), sinTheta = ma_sqrt(wi.x * wi.x + wi.y * wi.y);
-  float lobe = phongLobe(b, wi, ts.mirror);
-  float brdfCos = phongBrdf(b, lobe) * cosTheta;
+  float lobe = phongLobe(sp.brdf, wi, sp.mirror);
+  float brdfCos = phongBrdf(sp.brdf, lobe) * cosTheta;
   SampleValue s;
   s.r = hit.r * brdfCos;
   s.g = hit.g * brdfCos;
   s.b = hit.b * brdfCos;
-  techniquePdfs(ts, env, b, wi, texel, sinTheta, hit.pdf, lobe, s.pdfs);
+  techniquePdfs(ts, env, sp, wi, texel, sinTheta, hit.pdf, lobe, s.pdfs);
   MA_UNROLL
   for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
   if (ts.sharePdfs) bankSharePdfs(env, texel, sinTheta, s.sharePdfs);

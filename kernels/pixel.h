@@ -82,7 +82,7 @@ MA_FN float bankEnvmapFraction(int product, int n0, int n1, float alpha0) {
 }
 
 // The sample of `technique` with that technique's sample index `index`.
-MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c,
+MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, ShadingPoint sp, StageCounts c,
                                              int technique, ma_uint index, ma_uint seedLo, ma_uint seedHi,
                                              ma_uint pixel) {
   float N = (float)c.stageSamples;
@@ -94,7 +94,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
   float invP, scale;
   if (technique == MA_TECHNIQUE_ENVMAP && c.risCandidates > 0) {
     // [TCE05]: f(y) times the resampled sample's weight, over N.
-    ResampledSample y = resampleEnvmap(ts, env, b, c.risCandidates, seedLo, seedHi, pixel, index);
+    ResampledSample y = resampleEnvmap(ts, env, sp, c.risCandidates, seedLo, seedHi, pixel, index);
     s = y.value;
     invP = y.contributionWeight;
     scale = N;
@@ -104,7 +104,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Ph
     float mixtureU = isProductTechnique(ts, technique)
                          ? uniformFloat(philoxDrawPart(seedLo, seedHi, pixel, (ma_uint)technique, index, 1u).v[0])
                          : 0.0f;
-    s = evaluateSample(ts, env, b, technique, sampleTechnique(ts, env, b, technique, rnd, mixtureU));
+    s = evaluateSample(ts, env, sp, technique, sampleTechnique(ts, env, sp, technique, rnd, mixtureU));
     // Balance heuristic: f / (N p_α), p_α = Σ_k α_k p_k ([HS14] eq. 4.2). Count-independent
     // weights p_t/Σ_k p_k: f / (n_t Σ_k p_k) ([SHS16] eq. 26).
     float nt = technique == 0 ? (float)c.n0 : (technique == 1 ? (float)c.n1 : (float)c.n2);
@@ -172,7 +172,7 @@ MA_FN SampleContribution withOptimalWeights(SampleContribution s, StageCounts c,
 
 // Sample j of the stage. Multi-sample: the first n0 samples are technique 0's, the next
 // n1 technique 1's, ... One-sample: the technique is drawn with probabilities α_k.
-MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongParams b, StageCounts c, int j,
+MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, ShadingPoint sp, StageCounts c, int j,
                                          ma_uint seedLo, ma_uint seedHi, ma_uint pixel) {
   int technique;
   ma_uint index;
@@ -187,7 +187,7 @@ MA_FN SampleContribution takeStageSample(TechniqueSet ts, EnvmapView env, PhongP
     int start = technique == 0 ? 0 : (technique == 1 ? c.n0 : c.n0 + c.n1);
     index = firstIndexOf(c, technique) + (ma_uint)(j - start);
   }
-  return takeTechniqueSample(ts, env, b, c, technique, index, seedLo, seedHi, pixel);
+  return takeTechniqueSample(ts, env, sp, c, technique, index, seedLo, seedHi, pixel);
 }
 
 MA_FN PixelSums zeroPixelSums(void) {

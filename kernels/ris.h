@@ -33,8 +33,8 @@ MA_FN SampleValue selectSampleValue(int first, SampleValue a, SampleValue b) {
 // draw `index` (candidate 0 is envmap sampling's own sample `index`); its coin is word
 // i mod 4 of part i/4 of the resampling stream's. The kernel unrolls the loop (M is
 // compiled in; docs/pocl.md, rule 1), which folds its one branch, the coins' draw.
-MA_FN ResampledSample resampleEnvmap(TechniqueSet ts, EnvmapView env, PhongParams b, int candidates,
-                                     ma_uint seedLo, ma_uint seedHi, ma_uint pixel, ma_uint index) {
+MA_FN ResampledSample resampleEnvmap(TechniqueSet ts, EnvmapView env, ShadingPoint sp, int candidates, ma_uint seedLo,
+                                     ma_uint seedHi, ma_uint pixel, ma_uint index) {
   SampleValue kept;
   kept.r = kept.g = kept.b = 0.0f;
   MA_UNROLL
@@ -45,8 +45,8 @@ MA_FN ResampledSample resampleEnvmap(TechniqueSet ts, EnvmapView env, PhongParam
   for (int i = 0; i < candidates; ++i) {
     if (i % 4 == 0) coins = philoxDrawPart(seedLo, seedHi, pixel, MA_STREAM_RESAMPLING_CHOICE, index, (ma_uint)(i / 4));
     MaRandom4 rnd = philoxDrawPart(seedLo, seedHi, pixel, (ma_uint)MA_TECHNIQUE_ENVMAP, index, (ma_uint)i);
-    SampleValue x = evaluateSample(ts, env, b, MA_TECHNIQUE_ENVMAP,
-                                   sampleTechnique(ts, env, b, MA_TECHNIQUE_ENVMAP, rnd, 0.0f));
+    SampleValue x =
+        evaluateSample(ts, env, sp, MA_TECHNIQUE_ENVMAP, sampleTechnique(ts, env, sp, MA_TECHNIQUE_ENVMAP, rnd, 0.0f));
     // [TCE05]: w = p̂/p. A candidate's texel was drawn, so p > 0 but for underflow.
     float w = x.pdfs[0] > 0.0f ? luminance(x.r, x.g, x.b) / x.pdfs[0] : 0.0f;
     weightSum += w;

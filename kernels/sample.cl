@@ -124,17 +124,17 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   TechniqueSet ts;
   ts.techniqueCount = MA_TECHNIQUES;
   ts.splitBrdf = MA_SPLIT_BRDF;
-  ts.mirror = mirror;
   ts.product = productView(productFloats, productWords);
   ts.productMixture.diffuse = MA_PRODUCT_TABLES > 0 ? as_float(PIXEL_ROW(ROW_PRODUCT)) : 0.0f;
   ts.productMixture.specular = MA_PRODUCT_TABLES > 0 ? as_float(PIXEL_ROW(ROW_PRODUCT + 1)) : 0.0f;
   ts.productMixture.specularTable = MA_PRODUCT_TABLES > 0 ? PIXEL_ROW(ROW_PRODUCT + 2) : 0;
   ts.sharePdfs = MA_SHARE_COLUMNS > 0;
 
-  PhongParams b;
-  b.rhoD = as_float(PIXEL_ROW(ROW_RHO_D));
-  b.rhoS = as_float(PIXEL_ROW(ROW_RHO_S));
-  b.n = as_float(PIXEL_ROW(ROW_N));
+  ShadingPoint sp;
+  sp.brdf.rhoD = as_float(PIXEL_ROW(ROW_RHO_D));
+  sp.brdf.rhoS = as_float(PIXEL_ROW(ROW_RHO_S));
+  sp.brdf.n = as_float(PIXEL_ROW(ROW_N));
+  sp.mirror = mirror;
 
   StageCounts c;
   c.techniqueCount = MA_TECHNIQUES;
@@ -149,9 +149,9 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   c.first1 = (uint)PIXEL_ROW(ROW_FIRST1);
   c.first2 = (uint)PIXEL_ROW(ROW_FIRST2);
 #if MA_ONE_SAMPLE
-  return takeStageSample(ts, env, b, c, j, seedLo, seedHi, (uint)(firstPixel + pixel));
+  return takeStageSample(ts, env, sp, c, j, seedLo, seedHi, (uint)(firstPixel + pixel));
 #else
-  SampleContribution s = takeTechniqueSample(ts, env, b, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo,
+  SampleContribution s = takeTechniqueSample(ts, env, sp, c, technique, firstIndexOf(c, technique) + (uint)j, seedLo,
                                              seedHi, (uint)(firstPixel + pixel));
 #if MA_OPTIMAL_WEIGHTS
   OptimalCoefficients a;

@@ -38,6 +38,16 @@ kern::ProductView makeProductView(const ProductTables& t) {
   return p;
 }
 
+kern::ShadingPoint makeShadingPoint(const Scene& scene, int pixel) {
+  const PhongParameters& p = scene.grid.pixels[pixel];
+  kern::ShadingPoint sp;
+  sp.brdf.rhoD = p.rhoD;
+  sp.brdf.rhoS = p.rhoS;
+  sp.brdf.n = p.n;
+  sp.mirror = kern::makeVec3(scene.mirror[0], scene.mirror[1], scene.mirror[2]);
+  return sp;
+}
+
 namespace {
 
 // Pixel p's coefficients of the optimal weights as kernels/sample.cl reads them: all 0
@@ -70,7 +80,6 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   kern::TechniqueSet ts;
   ts.techniqueCount = M;
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
-  ts.mirror = kern::makeVec3(scene_.mirror[0], scene_.mirror[1], scene_.mirror[2]);
   ts.product = makeProductView(scene_.productTables);
   ts.productMixture = {};
   const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
@@ -86,13 +95,9 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
   for (int pixel = range.begin; pixel < range.end; ++pixel) {
     kern::EnvmapView pixelEnv = env;
     if (scene_.tables.hasBank()) pixelEnv.brdfBin = scene_.tables.brdfBinOfPixel[pixel];
-    const PhongParameters& p = scene_.grid.pixels[pixel];
-    kern::PhongParams b;
-    b.rhoD = p.rhoD;
-    b.rhoS = p.rhoS;
-    b.n = p.n;
+    const kern::ShadingPoint sp = makeShadingPoint(scene_, pixel);
     kern::TechniqueSet pixelTs = ts;
-    if (ts.product.tables > 0) pixelTs.productMixture = kern::productMixture(ts.product, b);
+    if (ts.product.tables > 0) pixelTs.productMixture = kern::productMixture(ts.product, sp.brdf);
     const kern::StageCounts c =
         kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
                               config_.estimator == Estimator::OneSample,
@@ -101,7 +106,7 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + kern::statsOffset(pixel, slots);
     for (int j = 0; j < plan.stageSamples; ++j) {
-      kern::SampleContribution s = kern::takeStageSample(pixelTs, pixelEnv, b, c, j, uint32_t(seed),
+      kern::SampleContribution s = kern::takeStageSample(pixelTs, pixelEnv, sp, c, j, uint32_t(seed),
                                                          uint32_t(seed >> 32), uint32_t(scene_.firstPixel + pixel));
       if (config_.optimalWeights) s = kern::withOptimalWeights(s, c, a);
       kern::addContribution(&sums, s);

@@ -3,11 +3,15 @@
 #include "KernelCode.h"
 #include "distributions/EnvmapDistribution.h"
 #include "distributions/ProductTables.h"
+#include "scene/Scene.h"
 
 namespace misalloc {
 
 kern::EnvmapView makeEnvmapView(const EnvmapTables& tables, float coskExponent);
 
 kern::ProductView makeProductView(const ProductTables& tables);
+
+// Pixel p of the scene as the point it shades: its BRDF and the scene's mirror direction.
+kern::ShadingPoint makeShadingPoint(const Scene& scene, int pixel);
 
 }  // namespace misalloc
