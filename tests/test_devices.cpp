@@ -6,9 +6,12 @@
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "CliRunner.h"
+#include "Covering.h"
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
@@ -81,32 +84,53 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
   // 40×26 pixels: not a whole number of 16-pixel blocks, so the last tile is partial.
   const Scene two = smallScene("rooitou_park", "seed000", 40, 26);
   const Scene three = smallScene("forest_slope", "seed000", 40, 26, true);
-  SamplerDevices one("cpu");
   // The host (C++ reference) computes what PoCL computes, bit for bit (kernels/sample.cl).
-  for (const std::string list : {twoCpuDevices(), std::string("cpu,host")}) {
-    SamplerDevices pair(list);
-    for (const Scene* scene : {&two, &three}) {
+  const std::vector<std::string> lists{twoCpuDevices(), "cpu,host"};
+  struct Case {
+    const std::string* list;
+    const Scene* scene;
+    Method method;
+    Estimator estimator;
+  };
+  std::vector<Case> cases;
+  std::vector<Configuration> settings;
+  for (const std::string& list : lists)
+    for (const Scene* scene : {&two, &three})
       for (Method method : allMethods()) {
-        // Small test size (the sanitizers): every method on two techniques, two on three.
-        if (smallTestSize() && scene == &three && method != Method::Equal && method != Method::Exact) continue;
         std::vector<Estimator> estimators{Estimator::MultiSample};
         if (!methodTraits(method).fixesEstimator()) estimators.push_back(Estimator::OneSample);
         // The count-independent weights need every technique sampled (render/RunChecks.h).
         if (method == Method::Equal) estimators.push_back(Estimator::CountIndependent);
         for (Estimator estimator : estimators) {
-          Rendering a = renderOn(one, *scene, method, estimator, 40);
-          Rendering b = renderOn(pair, *scene, method, estimator, 40);
-          INFO(fmt::format("--device {}: {} M={} estimator {}", list, methodName(method), scene->techniqueCount(),
-                           int(estimator)));
-          CHECK(sameBits(a.image, b.image));
-          CHECK(a.alpha == b.alpha);
-          REQUIRE(b.devices.size() == 2);
-          CHECK(b.devices[0].pixelStages + b.devices[1].pixelStages == a.devices[0].pixelStages);
+          cases.push_back({&list, scene, method, estimator});
+          settings.push_back({"devices=" + std::string(list == "cpu,host" ? "host" : "cpu"),
+                              fmt::format("M={}", scene->techniqueCount()), "method=" + methodName(method),
+                              fmt::format("estimator={}", int(estimator))});
         }
       }
-    }
-    if (list == "cpu,host") CHECK(pair.name().find(kHostSamplerName) != std::string::npos);
+  // Pairwise (tests/Covering.h): every method with every estimator, device pair and M;
+  // small test size (the sanitizers): of M = 3, equal and exact only.
+  std::vector<size_t> chosen(cases.size());
+  for (size_t i = 0; i < chosen.size(); ++i) chosen[i] = i;
+  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
+  SamplerDevices one("cpu");
+  std::map<std::string, std::unique_ptr<SamplerDevices>> pairs;
+  for (size_t i : chosen) {
+    const Case& c = cases[i];
+    if (smallTestSize() && c.scene == &three && c.method != Method::Equal && c.method != Method::Exact) continue;
+    auto& pair = pairs[*c.list];
+    if (!pair) pair = std::make_unique<SamplerDevices>(*c.list);
+    Rendering a = renderOn(one, *c.scene, c.method, c.estimator, 40);
+    Rendering b = renderOn(*pair, *c.scene, c.method, c.estimator, 40);
+    INFO(fmt::format("--device {}: {} M={} estimator {}", *c.list, methodName(c.method), c.scene->techniqueCount(),
+                     int(c.estimator)));
+    CHECK(sameBits(a.image, b.image));
+    CHECK(a.alpha == b.alpha);
+    REQUIRE(b.devices.size() == 2);
+    CHECK(b.devices[0].pixelStages + b.devices[1].pixelStages == a.devices[0].pixelStages);
   }
+  REQUIRE(pairs.count("cpu,host") == 1);
+  CHECK(pairs["cpu,host"]->name().find(kHostSamplerName) != std::string::npos);
 }
 
 TEST_CASE("a failed device's tiles run again on the others: the same image", "[devices]") {
