@@ -46,8 +46,8 @@ struct SampleTerm {
 SampleTerm brdfTerm(const PixelPass& p, uint32_t index) {
   const kern::MaRandom4 rnd = kern::philoxDraw(p.seedLo, p.seedHi, p.pixelKey, 1u, index);
   const float u1 = kern::uniformFloat(rnd.v[1]), u2 = kern::uniformFloat(rnd.v[2]);
-  const kern::MaVec3 diffuse = kern::sampleDiffuse(u1, u2);
-  const kern::MaVec3 specular = kern::sampleSpecular(p.point.brdf, p.point.mirror, u1, u2);
+  const kern::MaVec3 diffuse = kern::sampleDiffuse(p.point.normalFrame, u1, u2);
+  const kern::MaVec3 specular = kern::sampleSpecular(p.point.brdf, p.point.mirrorFrame, u1, u2);
   const bool isDiffuse = kern::uniformFloat(rnd.v[0]) < kern::diffuseLobeWeight(p.point.brdf);
   kern::TechniqueSample drawn;
   drawn.wi = kern::makeVec3(isDiffuse ? diffuse.x : specular.x, isDiffuse ? diffuse.y : specular.y,

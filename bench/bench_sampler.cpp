@@ -8,7 +8,12 @@
 //
 //   build/bench/misalloc_bench [--device cpu] [--size 256] [--spp 64] [--summary FILE.json]
 //                              [--envmap forest_slope] [--procedural-width 512]
-//                              [google benchmark flags]
+//                              [--frames flat|dome|random] [google benchmark flags]
+//
+// --frames gives the pixels frames of their own (kernels/estimator.h, ShadingPoint): a
+// dome seen from above (the normals of a hemisphere, each pixel's neighbours alike), or
+// a normal and a view drawn at random per pixel (no two pixels' BRDF samples alike, the
+// worst case for the map's cache lines); flat, the default, is [HS14]'s plane.
 //
 // A procedural map a few texels wide (`--envmap constant --procedural-width 16`) keeps
 // every table in L1: the kernels' rate without the cost of their table reads, the
@@ -39,7 +44,7 @@ using namespace misalloc;
 namespace {
 
 struct Config {
-  std::string device = "cpu", envmap = "forest_slope";
+  std::string device = "cpu", envmap = "forest_slope", frames = "flat";
   int size = 256, spp = 64, proceduralWidth = 512;
 } config;
 
@@ -64,13 +69,43 @@ const Variant kVariants[] = {
 // single sample one float ulp off would show at 1e-9 or more.
 constexpr double kPeerAgreement = 1e-12;
 
+Vec3f normalised(double x, double y, double z) {
+  const double len = std::sqrt(x * x + y * y + z * z);
+  return {float(x / len), float(y / len), float(z / len)};
+}
+
+// Pixel (i, j)'s frame under --frames: seen along z from above.
+PixelFrame benchFrame(int i, int j) {
+  const Vec3f up{0.0f, 0.0f, 1.0f};
+  if (config.frames == "dome") {
+    // The hemisphere over the image's inscribed disc; outside it, its rim's normal.
+    const double x = 2 * (i + 0.5) / config.size - 1, y = 1 - 2 * (j + 0.5) / config.size;
+    const double r2 = x * x + y * y;
+    const Vec3f n = r2 < 0.99 ? normalised(x, y, std::sqrt(1 - r2)) : normalised(x, y, 0.1);
+    return {n, mirrorDirection(n, up)};
+  }
+  // random: a normal on the upper hemisphere and a view above its horizon, by a hash of the pixel.
+  uint64_t h = (uint64_t(j) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(i) * 0xbf58476d1ce4e5b9ull);
+  auto uniform = [&h] {
+    h = (h ^ (h >> 31)) * 0x94d049bb133111ebull + 0x2545f4914f6cdd1dull;
+    return double(h >> 11) / 9007199254740992.0;
+  };
+  const Vec3f n = normalised(uniform() - 0.5, uniform() - 0.5, uniform() + 0.1);
+  const Vec3f v = normalised(n[0] + uniform() - 0.5, n[1] + uniform() - 0.5, n[2] + 0.2);
+  return {n, mirrorDirection(n, v)};
+}
+
 Scene benchScene(EnvmapSampler sampler) {
   SceneOptions o;
   o.width = o.height = config.size;
   o.sampler = sampler;
   o.envmap = config.envmap;
   o.proceduralWidth = config.proceduralWidth;
-  return makeScene(o);
+  Scene scene = makeScene(o);
+  if (config.frames != "flat")
+    for (int j = 0; j < config.size; ++j)
+      for (int i = 0; i < config.size; ++i) scene.geometry.pixels[size_t(j) * config.size + i] = benchFrame(i, j);
+  return scene;
 }
 
 // What a render of the variant's method builds: ris its own estimator.
@@ -160,7 +195,12 @@ int main(int argc, char** argv) {
                         {"--size", [](const char* v) { config.size = std::stoi(v); }},
                         {"--spp", [](const char* v) { config.spp = std::stoi(v); }},
                         {"--envmap", [](const char* v) { config.envmap = v; }},
-                        {"--procedural-width", [](const char* v) { config.proceduralWidth = std::stoi(v); }}});
+                        {"--procedural-width", [](const char* v) { config.proceduralWidth = std::stoi(v); }},
+                        {"--frames", [](const char* v) { config.frames = v; }}});
+  if (config.frames != "flat" && config.frames != "dome" && config.frames != "random") {
+    fmt::print(stderr, "misalloc_bench: --frames {}: expected flat, dome or random\n", config.frames);
+    return 2;
+  }
   bench::initialize(rest);
   std::vector<std::string> names;
   for (const Variant& v : kVariants) {
@@ -173,15 +213,17 @@ int main(int argc, char** argv) {
   }
   bench::MedianCollector reporter("samples/s");
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  bench::PeerTable table{fmt::format("Sampling, {}x{} pixels, {} spp, envmap {}, OpenCL device: {}", config.size,
-                                     config.size, config.spp, config.envmap, device().name()),
-                         "technique",
-                         "Msample/s",
-                         {{"device", device().name()},
-                          {"width", config.size},
-                          {"height", config.size},
-                          {"spp", config.spp},
-                          {"envmap", config.envmap},
-                          {"procedural_width", config.proceduralWidth}}};
+  bench::PeerTable table{
+      fmt::format("Sampling, {}x{} pixels, {} spp, envmap {}, frames {}, OpenCL device: {}", config.size, config.size,
+                  config.spp, config.envmap, config.frames, device().name()),
+      "technique",
+      "Msample/s",
+      {{"device", device().name()},
+       {"width", config.size},
+       {"height", config.size},
+       {"spp", config.spp},
+       {"envmap", config.envmap},
+       {"frames", config.frames},
+       {"procedural_width", config.proceduralWidth}}};
   bench::finish({table.addMedians(reporter, names, 1e6)});
 }

@@ -107,6 +107,11 @@ MA_FN MaVec3 makeVec3(float x, float y, float z) {
   return v;
 }
 
+// c ? a : b, component by component: a conditional between two structs compiles to a
+// branch, which keeps PoCL's work-item loop from being vectorised; between floats it is
+// a select.
+MA_FN MaVec3 selectVec3(int c, MaVec3 a, MaVec3 b) { return makeVec3(c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z); }
+
 MA_FN float dot3(MaVec3 a, MaVec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 MA_FN MaVec3 scale3(MaVec3 a, float s) { return makeVec3(a.x * s, a.y * s, a.z * s); }

@@ -26,11 +26,14 @@ MA_FN int techniqueRole(int splitBrdf, int product, int technique) {
 }
 
 // The point a pixel shades, as every technique's sample and pdf read it (pbrt-v4's
-// LightSampleContext, Mitsuba 3's Interaction): its BRDF and the mirror direction of its
-// view ω_o, in its shading frame, where the normal is z.
+// LightSampleContext, Mitsuba 3's Interaction): its BRDF, and the frames (frameAbout)
+// of its shading normal and of the mirror direction of its view ω_o about it, in the
+// map's frame (kernels/envmap.h). The map and its pdfs stay in that frame: only the
+// BRDF's lobes and cos θ_i turn with the normal.
 typedef struct {
   PhongParams brdf;
-  MaVec3 mirror;
+  MaFrame normalFrame;  // z: the normal
+  MaFrame mirrorFrame;  // z: the mirror direction
 } ShadingPoint;
 
 typedef struct {
@@ -69,10 +72,10 @@ MA_FN TechniqueSample sampleTechnique(TechniqueSet ts, EnvmapView env, ShadingPo
     s.wi = e.w;
     s.texel = e.texel;
   } else if (role == ROLE_BRDF) {
-    s.wi = sampleBrdf(sp.brdf, sp.mirror, rnd);
+    s.wi = sampleBrdf(sp.brdf, sp.normalFrame, sp.mirrorFrame, rnd);
   } else {
     float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
-    s.wi = role == ROLE_DIFFUSE ? sampleDiffuse(u1, u2) : sampleSpecular(sp.brdf, sp.mirror, u1, u2);
+    s.wi = sampleLobe(sp.brdf, sp.normalFrame, sp.mirrorFrame, role == ROLE_DIFFUSE, u1, u2);
   }
   return s;
 }
@@ -86,8 +89,8 @@ MA_FN void techniquePdfs(TechniqueSet ts, EnvmapView env, ShadingPoint sp, MaVec
     int role = roleOf(ts, k);
     pdfs[k] = k >= ts.techniqueCount  ? 0.0f
               : role == ROLE_ENVMAP   ? envmapPdf
-              : role == ROLE_BRDF     ? brdfPdf(sp.brdf, wi, lobe)
-              : role == ROLE_DIFFUSE  ? diffusePdf(wi)
+              : role == ROLE_BRDF     ? brdfPdf(sp.brdf, sp.normalFrame.z, wi, lobe)
+              : role == ROLE_DIFFUSE  ? diffusePdf(sp.normalFrame.z, wi)
               : role == ROLE_SPECULAR ? specularPdf(sp.brdf, lobe)
                                       : productPdf(env, ts.product, ts.productMixture, t, envmapPdf, sinTheta);
   }
@@ -115,8 +118,9 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, ShadingPoint s
   MaVec3 wi = sample.wi;
   int texel = drawsTexel(ts, technique) ? sample.texel : texelOfDirection(env, wi);
   EnvmapHit hit = envmapTexelHit(env, texel, wi);
-  float cosTheta = ma_max(wi.z, 0.0f), sinTheta = ma_sqrt(wi.x * wi.x + wi.y * wi.y);
-  float lobe = phongLobe(sp.brdf, wi, sp.mirror);
+  // cos θ_i against the normal; sin θ of the map's own latitude, for its pdf.
+  float cosTheta = cosAboveSurface(sp.normalFrame.z, wi), sinTheta = ma_sqrt(wi.x * wi.x + wi.y * wi.y);
+  float lobe = phongLobe(sp.brdf, wi, sp.mirrorFrame.z);
   float brdfCos = phongBrdf(sp.brdf, lobe) * cosTheta;
   SampleValue s;
   s.r = hit.r * brdfCos;

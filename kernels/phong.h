@@ -1,6 +1,6 @@
 // Physically corrected Lafortune–Phong BRDF ([HS14] Sec. 5.2, eq. 6.13 with α measured
 // from the mirror direction of ω_o) and its two sampling lobes: a cosine lobe about
-// the normal (z) and a cos^n lobe about the mirror direction. Host side:
+// the normal and a cos^n lobe about the mirror direction, both in the map's frame. Host side:
 // host/scene/BrdfGrid.h holds the per-pixel parameters.
 #include "namespace_check.h"
 #ifndef MA_PHONG_H
@@ -36,8 +36,11 @@ MA_FN float phongBrdf(PhongParams b, float lobe) {
   return b.rhoD * MA_INV_PI + b.rhoS * (b.n + 2.0f) * (0.5f * MA_INV_PI) * lobe;
 }
 
+// cos θ_i against the normal, 0 below the surface.
+MA_FN float cosAboveSurface(MaVec3 normal, MaVec3 wi) { return ma_max(dot3(normal, wi), 0.0f); }
+
 // Cosine lobe: p = cos θ / π on the upper hemisphere.
-MA_FN float diffusePdf(MaVec3 wi) { return ma_max(wi.z, 0.0f) * MA_INV_PI; }
+MA_FN float diffusePdf(MaVec3 normal, MaVec3 wi) { return cosAboveSurface(normal, wi) * MA_INV_PI; }
 
 // Phong lobe about the mirror direction: p = (n+1)/(2π) cos^n α. Part of it may lie
 // below the horizon; such samples contribute zero but count.
@@ -51,51 +54,90 @@ MA_FN float diffuseLobeWeight(PhongParams b) {
 }
 
 // BRDF×cos technique: the albedo-weighted mixture of the two lobes.
-MA_FN float brdfPdf(PhongParams b, MaVec3 wi, float lobe) {
+MA_FN float brdfPdf(PhongParams b, MaVec3 normal, MaVec3 wi, float lobe) {
   float wd = diffuseLobeWeight(b);
-  return wd * diffusePdf(wi) + (1.0f - wd) * specularPdf(b, lobe);
+  return wd * diffusePdf(normal, wi) + (1.0f - wd) * specularPdf(b, lobe);
 }
 
-// Orthonormal basis about a unit vector (Duff et al. 2017, branch-free).
-MA_FN MaVec3 lobeToWorld(MaVec3 axis, float x, float y, float z) {
+// An orthonormal basis t, s, z about a unit vector z (Duff et al. 2017, branch-free):
+// a shading point carries the bases of its two lobes (kernels/estimator.h).
+typedef struct {
+  MaVec3 t, s, z;
+} MaFrame;
+
+MA_FN MaFrame frameAbout(MaVec3 axis) {
   float sign = axis.z >= 0.0f ? 1.0f : -1.0f;
   float a = -1.0f / (sign + axis.z);
   float b = axis.x * axis.y * a;
-  MaVec3 t = makeVec3(1.0f + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
-  MaVec3 s = makeVec3(b, sign + axis.y * axis.y * a, -axis.y);
-  return makeVec3(x * t.x + y * s.x + z * axis.x, x * t.y + y * s.y + z * axis.y, x * t.z + y * s.z + z * axis.z);
+  MaFrame f;
+  f.t = makeVec3(1.0f + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
+  f.s = makeVec3(b, sign + axis.y * axis.y * a, -axis.y);
+  f.z = axis;
+  return f;
 }
 
-// A direction about `axis` with cos = cosAlpha and azimuth 2πu.
-MA_FN MaVec3 directionAbout(MaVec3 axis, float cosAlpha, float u) {
+MA_FN MaVec3 frameToWorld(MaFrame f, float x, float y, float z) {
+  return makeVec3(x * f.t.x + y * f.s.x + z * f.z.x, x * f.t.y + y * f.s.y + z * f.z.y,
+                  x * f.t.z + y * f.s.z + z * f.z.z);
+}
+
+MA_FN MaVec3 lobeToWorld(MaVec3 axis, float x, float y, float z) { return frameToWorld(frameAbout(axis), x, y, z); }
+
+// A direction about the frame's z with cos = cosAlpha and azimuth 2πu.
+MA_FN MaVec3 directionAbout(MaFrame f, float cosAlpha, float u) {
   float sinAlpha = ma_sqrt(ma_max((1.0f - cosAlpha) * (1.0f + cosAlpha), 0.0f));
   MaSinCos phi = sinCos2Pi(u);
-  return lobeToWorld(axis, sinAlpha * phi.c, sinAlpha * phi.s, cosAlpha);
+  return frameToWorld(f, sinAlpha * phi.c, sinAlpha * phi.s, cosAlpha);
 }
 
-// A direction about `axis` with 1 − cos = d ∈ [0, 2] and azimuth 2πu: sin α =
+// A direction about the frame's z with 1 − cos = d ∈ [0, 2] and azimuth 2πu: sin α =
 // √(d (2 − d)) keeps its precision where cos α rounds to 1.
-MA_FN MaVec3 directionAboutD(MaVec3 axis, float d, float u) {
+MA_FN MaVec3 directionAboutD(MaFrame f, float d, float u) {
   float sinAlpha = ma_sqrt(ma_max(d * (2.0f - d), 0.0f));
   MaSinCos phi = sinCos2Pi(u);
-  return lobeToWorld(axis, sinAlpha * phi.c, sinAlpha * phi.s, 1.0f - d);
+  return frameToWorld(f, sinAlpha * phi.c, sinAlpha * phi.s, 1.0f - d);
 }
 
-MA_FN MaVec3 sampleDiffuse(float u1, float u2) {
-  return directionAbout(makeVec3(0.0f, 0.0f, 1.0f), ma_sqrt(1.0f - u1), u2);
+// The cosine lobe about the normal, its frame's z.
+MA_FN MaVec3 sampleDiffuse(MaFrame normalFrame, float u1, float u2) {
+  return directionAbout(normalFrame, ma_sqrt(1.0f - u1), u2);
 }
 
 // cos α = u^(1/(n+1)) inverts the CDF of the cos^n lobe (u = 1 − u1 ∈ (0, 1]), taken
 // as 1 − cos α = −expm1(ln u / (n+1)) so that it stays exact to float precision for
 // n up to 10⁵, where cos α itself is within a few ulps of 1.
-MA_FN MaVec3 sampleSpecular(PhongParams b, MaVec3 mirror, float u1, float u2) {
-  float d = -fastExpm1(fastLog2(1.0f - u1) * MA_LN2 / (b.n + 1.0f));
-  return directionAboutD(mirror, d, u2);
+MA_FN float specularOneMinusCos(PhongParams b, float u1) {
+  return -fastExpm1(fastLog2(1.0f - u1) * MA_LN2 / (b.n + 1.0f));
 }
 
-MA_FN MaVec3 sampleBrdf(PhongParams b, MaVec3 mirror, MaRandom4 rnd) {
+// The Phong lobe about the mirror direction, its frame's z.
+MA_FN MaVec3 sampleSpecular(PhongParams b, MaFrame mirrorFrame, float u1, float u2) {
+  return directionAboutD(mirrorFrame, specularOneMinusCos(b, u1), u2);
+}
+
+// sampleDiffuse's or sampleSpecular's direction, bit for bit, where the lobe is picked
+// per sample (the BRDF technique, the one-sample estimator): both lobes' angles, which
+// are cheap, then one azimuth and one change of basis.
+MA_FN MaVec3 sampleLobe(PhongParams b, MaFrame normalFrame, MaFrame mirrorFrame, int diffuse, float u1, float u2) {
+  // sin²α as directionAbout and directionAboutD compute it, (1 − cos)(1 + cos) or
+  // d (2 − d), from selected factors: one product, since LLVM's SLP vectoriser pairs two
+  // like expressions into a 2-wide vector, and a call in an arm of ?: (ma_max is one)
+  // stays a branch; either keeps PoCL's sample loop scalar (docs/pocl.md, rule 8).
+  float cosDiffuse = ma_sqrt(1.0f - u1), d = specularOneMinusCos(b, u1);
+  float cosAlpha = diffuse ? cosDiffuse : 1.0f - d;
+  float p = diffuse ? 1.0f - cosDiffuse : d, q = diffuse ? 1.0f + cosDiffuse : 2.0f - d;
+  float sinAlpha = ma_sqrt(ma_max(p * q, 0.0f));
+  MaSinCos phi = sinCos2Pi(u2);
+  MaFrame f;
+  f.t = selectVec3(diffuse, normalFrame.t, mirrorFrame.t);
+  f.s = selectVec3(diffuse, normalFrame.s, mirrorFrame.s);
+  f.z = selectVec3(diffuse, normalFrame.z, mirrorFrame.z);
+  return frameToWorld(f, sinAlpha * phi.c, sinAlpha * phi.s, cosAlpha);
+}
+
+MA_FN MaVec3 sampleBrdf(PhongParams b, MaFrame normalFrame, MaFrame mirrorFrame, MaRandom4 rnd) {
   float u1 = uniformFloat(rnd.v[1]), u2 = uniformFloat(rnd.v[2]);
-  return uniformFloat(rnd.v[0]) < diffuseLobeWeight(b) ? sampleDiffuse(u1, u2) : sampleSpecular(b, mirror, u1, u2);
+  return sampleLobe(b, normalFrame, mirrorFrame, uniformFloat(rnd.v[0]) < diffuseLobeWeight(b), u1, u2);
 }
 
 #endif

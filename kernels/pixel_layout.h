@@ -11,15 +11,21 @@
 // and Σ w².
 enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
 
-// What a pixel's samples share, one 32-bit word per row: its BRDF, BRDF bin, counts and
-// first sample indices; then, with --weights optimal, the coefficients a_{c,k} at row
-// ROW_COEFFICIENTS + c·M + k; then, with --product, its ProductMixture (diffuse,
-// specular, specular table).
+// What a pixel's samples share, one 32-bit word per row: its shading point (BRDF, BRDF
+// bin, normal, mirror direction), counts and first sample indices; then, with --weights optimal, the coefficients
+// a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with --product, its ProductMixture (diffuse, specular, specular
+// table).
 enum {
   ROW_RHO_D,
   ROW_RHO_S,
   ROW_N,
   ROW_BRDF_BIN,
+  ROW_NORMAL_X,
+  ROW_NORMAL_Y,
+  ROW_NORMAL_Z,
+  ROW_MIRROR_X,
+  ROW_MIRROR_Y,
+  ROW_MIRROR_Z,
   ROW_N0,
   ROW_N1,
   ROW_N2,
@@ -38,9 +44,10 @@ MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product) {
   return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product);
 }
 
-// The per-pixel buffers, pixel p's first element. BRDF words: ρ_d, ρ_s, n, BRDF bin.
-#define MA_BRDF_WORDS 4
-MA_FN int brdfOffset(int pixel) { return MA_BRDF_WORDS * pixel; }
+// The per-pixel buffers, pixel p's first element. Shading point words: the first
+// ROW_N0 rows, ρ_d to the mirror direction's z.
+#define MA_SHADING_POINT_WORDS ROW_N0
+MA_FN int shadingPointOffset(int pixel) { return MA_SHADING_POINT_WORDS * pixel; }
 // The estimate: R, G, B.
 MA_FN int estimateOffset(int pixel) { return 3 * pixel; }
 // The moments: Σ w, Σ w² per technique.

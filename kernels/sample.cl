@@ -55,26 +55,21 @@ MA_FN ProductView productView(__global const float* productFloats, __global cons
 }
 
 // Writes what a pixel's samples share into its rows: row r at pixelRows[r·rowStride + column].
-MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __global const float* brdfParams,
+MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __global const float* shadingPoints,
                          __global const int* counts, __global const uint* firstIndex,
                          __global const float* coefficients, __global const float* productFloats,
                          __global const uint* productWords, int stageSamples, int pixel) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                             MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  __global const float* brdf = brdfParams + brdfOffset(pixel);
-  int rowValues[ROW_COEFFICIENTS] = {as_int(brdf[0]),
-                                     as_int(brdf[1]),
-                                     as_int(brdf[2]),
-                                     as_int(brdf[3]),
-                                     pixelCounts.n0,
-                                     pixelCounts.n1,
-                                     pixelCounts.n2,
-                                     (int)pixelCounts.first0,
-                                     (int)pixelCounts.first1,
-                                     (int)pixelCounts.first2};
+  __global const float* point = shadingPoints + shadingPointOffset(pixel);
   MA_UNROLL
-  for (int r = 0; r < ROW_COEFFICIENTS; ++r) PIXEL_ROW(r) = rowValues[r];
+  for (int r = 0; r < MA_SHADING_POINT_WORDS; ++r) PIXEL_ROW(r) = as_int(point[r]);
+  int countValues[ROW_COEFFICIENTS - ROW_N0] = {pixelCounts.n0,          pixelCounts.n1,
+                                                pixelCounts.n2,          (int)pixelCounts.first0,
+                                                (int)pixelCounts.first1, (int)pixelCounts.first2};
+  MA_UNROLL
+  for (int r = ROW_N0; r < ROW_COEFFICIENTS; ++r) PIXEL_ROW(r) = countValues[r - ROW_N0];
 #if MA_OPTIMAL_WEIGHTS
   MA_UNROLL
   for (int r = 0; r < 3 * MA_TECHNIQUES; ++r)
@@ -82,15 +77,22 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #endif
 #if MA_PRODUCT_TABLES > 0
   PhongParams phong;
-  phong.rhoD = brdf[0];
-  phong.rhoS = brdf[1];
-  phong.n = brdf[2];
+  phong.rhoD = point[ROW_RHO_D];
+  phong.rhoS = point[ROW_RHO_S];
+  phong.n = point[ROW_N];
   ProductMixture mixture = productMixture(productView(productFloats, productWords), phong);
   PIXEL_ROW(ROW_PRODUCT) = as_int(mixture.diffuse);
   PIXEL_ROW(ROW_PRODUCT + 1) = as_int(mixture.specular);
   PIXEL_ROW(ROW_PRODUCT + 2) = mixture.specularTable;
 #endif
 #undef PIXEL_ROW
+}
+
+// The unit vector at rows row, row + 1, row + 2, and the basis about it.
+MA_FN MaFrame frameOfRows(__local const int* pixelRows, int rowStride, int column, int row) {
+#define ROW_FLOAT(r) as_float(pixelRows[(row + (r)) * rowStride + column])
+  return frameAbout(makeVec3(ROW_FLOAT(0), ROW_FLOAT(1), ROW_FLOAT(2)));
+#undef ROW_FLOAT
 }
 
 // Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
@@ -101,9 +103,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
                                        __global const uint* aliasTable, __global const float* blockProbs,
                                        __global const float* productFloats, __global const uint* productWords,
                                        int width, int height, float coskExponent, __local const int* pixelRows,
-                                       int rowStride, int column,
-                                       MaVec3 mirror, int stageSamples, uint seedLo, uint seedHi, int firstPixel,
-                                       int pixel, int technique, int j) {
+                                       int rowStride, int column, int stageSamples, uint seedLo, uint seedHi,
+                                       int firstPixel, int pixel, int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   EnvmapView env;
   env.texels = texels;
@@ -134,7 +135,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   sp.brdf.rhoD = as_float(PIXEL_ROW(ROW_RHO_D));
   sp.brdf.rhoS = as_float(PIXEL_ROW(ROW_RHO_S));
   sp.brdf.n = as_float(PIXEL_ROW(ROW_N));
-  sp.mirror = mirror;
+  sp.normalFrame = frameOfRows(pixelRows, rowStride, column, ROW_NORMAL_X);
+  sp.mirrorFrame = frameOfRows(pixelRows, rowStride, column, ROW_MIRROR_X);
 
   StageCounts c;
   c.techniqueCount = MA_TECHNIQUES;
@@ -177,14 +179,13 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 #define MA_OPTIONAL_PARAMETERS
 #define MA_COEFFICIENTS ((__global const float*)0)
 #endif
-#define MA_SAMPLE_STAGE_PARAMETERS                                                                                  \
-  __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                    \
-      __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,     \
-      int width, int height, float coskExponent, __global const float *brdfParams, float mirrorX, float mirrorY,    \
-      float mirrorZ, __global const int *counts, __global const uint *firstIndex, int stageSamples, uint seedLo,    \
-      uint seedHi, int firstPixel, int pixelCount, __global const int *pixelOrder, __global ma_acc *estimate,       \
-      __global ma_acc *moments, __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, \
-      int spareSamples MA_OPTIONAL_PARAMETERS
+#define MA_SAMPLE_STAGE_PARAMETERS                                                                                 \
+  __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                   \
+      __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,    \
+      int width, int height, float coskExponent, __global const float *shadingPoints, __global const int *counts,  \
+      __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixelCount, \
+      __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments, __global ma_acc *stats, \
+      __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
@@ -197,7 +198,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The running sums carry over from earlier stages.
   for (int s = 0; s < STAT_SLOTS; ++s) running[s][lid] = stats[statsOffset(pixel, STAT_SLOTS) + s];
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
-  loadPixelRows(pixelRows, MA_LOCAL_SIZE, lid, brdfParams, counts, firstIndex, MA_COEFFICIENTS, productFloats,
+  loadPixelRows(pixelRows, MA_LOCAL_SIZE, lid, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
                 productWords, stageSamples, pixel);
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
@@ -216,8 +217,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
       SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width,
-                                           height, coskExponent, pixelRows, MA_LOCAL_SIZE, lid, makeVec3(mirrorX, mirrorY, mirrorZ),
-                                           stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+                                           height, coskExponent, pixelRows, MA_LOCAL_SIZE, lid, stageSamples, seedLo,
+                                           seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;
@@ -277,6 +278,10 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 // each sample's terms go to local memory in float, and lane 0 adds a chunk of them in
 // the C++ reference's order (addContribution), which keeps the sums bit for bit its sums.
 // Statistics and stored samples stay with sampleStage.
+// The pixel's rows two words apart: LLVM's SLP vectoriser loads adjacent rows (the
+// normal's x, y, z) as 2-wide vectors and pairs the terms of its basis, which keeps the
+// sample loop scalar (docs/pocl.md, rule 8): 2.6x the time of the whole stage.
+#define PIXEL_ROW_STRIDE 2
 #define PASSES_PER_CHUNK 8
 #define CHUNK_SAMPLES (PASSES_PER_CHUNK * MA_PIXEL_LANES)
 enum { TERM_R, TERM_G, TERM_B, TERM_W, TERM_TECHNIQUE, TERM_COUNT };
@@ -297,28 +302,28 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void samplePixelStage(MA_SAMPLE_STAGE_PARAMETERS) {
-  __local int pixelRows[ROW_COUNT];
+  __local int pixelRows[ROW_COUNT * PIXEL_ROW_STRIDE];
   __local float terms[TERM_COUNT * CHUNK_SAMPLES];
   __local PixelSums pixelSums;
   int lid = (int)get_local_id(0);
   int pixel = pixelOrder[get_group_id(0)];
   if (lid == 0) {
-    loadPixelRows(pixelRows, 1, 0, brdfParams, counts, firstIndex, MA_COEFFICIENTS, productFloats, productWords,
-                  stageSamples, pixel);
+    loadPixelRows(pixelRows, PIXEL_ROW_STRIDE, 0, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
+                  productWords, stageSamples, pixel);
     pixelSums = zeroPixelSums();
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   MA_UNROLL
   for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
-    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[ROW_N0 + k];
+    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
     for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
       int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
       for (int p = 0; p < passes; ++p) {
         // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
         int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
         SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                             width, height, coskExponent, pixelRows, 1, 0, makeVec3(mirrorX, mirrorY, mirrorZ),
-                                             stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+                                             width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples,
+                                             seedLo, seedHi, firstPixel, pixel, k, jk);
         terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
         terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
         terms[TERM_B * CHUNK_SAMPLES + t] = c.b;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "Constants.h"
+#include "KernelCode.h"
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "render/Method.h"
@@ -31,6 +32,38 @@ inline Scene smallScene(const std::string& envmap, const std::string& grid, int 
   o.viewTheta = viewTheta;
   o.proceduralWidth = 128;
   return makeScene(o);
+}
+
+// A unit direction drawn uniformly on the sphere from Philox stream `key`, draw `index`.
+inline Vec3f randomDirection(uint32_t key, uint32_t index) {
+  const kern::MaRandom4 r = kern::philoxDraw(0x6e0, 0, key, 7u, index);
+  const double z = 1 - 2 * (double(r.v[0]) + 0.5) / 4294967296.0, phi = 2 * kPi * double(r.v[1]) / 4294967296.0;
+  const double s = std::sqrt(std::max(0.0, 1 - z * z));
+  return {float(s * std::cos(phi)), float(s * std::sin(phi)), float(z)};
+}
+
+// A frame with normal `normal` seen from ω_o = `view` (unit vectors, n·ω_o > 0).
+inline PixelFrame frameSeenFrom(const Vec3f& normal, const Vec3f& view) {
+  return {normal, mirrorDirection(normal, view)};
+}
+
+// Every pixel of `scene` in a frame of its own: a normal anywhere on the sphere (facing
+// the map's ground too) and a view in its upper hemisphere, at least 3° above its horizon.
+inline void giveRandomFrames(Scene& scene, uint32_t key) {
+  for (int p = 0; p < scene.pixelCount(); ++p) {
+    const Vec3f n = randomDirection(key, uint32_t(2 * p));
+    Vec3f v = randomDirection(key, uint32_t(2 * p + 1));
+    double d = double(n[0]) * v[0] + double(n[1]) * v[1] + double(n[2]) * v[2];
+    if (d < 0) v = {-v[0], -v[1], -v[2]}, d = -d;
+    if (d < 0.05) {  // lifted off the horizon: ω_o + (0.05 − n·ω_o) n, normalised
+      Vec3f lifted;
+      double len = 0;
+      for (int c = 0; c < 3; ++c) lifted[c] = float(v[c] + (0.05 - d) * n[c]), len += double(lifted[c]) * lifted[c];
+      for (int c = 0; c < 3; ++c) lifted[c] = float(lifted[c] / std::sqrt(len));
+      v = lifted;
+    }
+    scene.geometry.pixels[size_t(p)] = frameSeenFrom(n, v);
+  }
 }
 
 // The sampler of the statistical sweeps: the C++ reference, which computes the kernel's

@@ -1,10 +1,11 @@
 // The optimal pdf's tables cached on disk (distributions/BankCache.h): a hit gives the
 // tables a build gives, bit for bit; a changed map, grid, view or sampler misses; a
 // damaged entry is rebuilt, never used.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "SceneFixtures.h"
 #include "distributions/BankCache.h"
@@ -55,7 +56,9 @@ Scene optimalScene(const std::string& envmap, const std::string& grid, const std
   return scene;
 }
 
-std::string keyOf(const Scene& s) { return bankCacheKey(s.envmap, s.options.sampler, s.grid, s.mirror); }
+std::string keyOf(const Scene& s) {
+  return bankCacheKey(s.envmap, s.options.sampler, s.grid, flatMirror(s.geometry, "--envmap-pdf optimal"));
+}
 
 }  // namespace
 
@@ -87,14 +90,15 @@ TEST_CASE("the bank cache's key names everything the bank is built from", "[bank
   const std::string dir = cache.path.string();
   const std::string base = keyOf(optimalScene("cosk:2", "seed000", dir));
   CHECK(keyOf(optimalScene("cosk:2", "seed000", dir)) == base);
-  CHECK(keyOf(optimalScene("cosk:4", "seed000", dir)) != base);                       // the map
-  CHECK(keyOf(optimalScene("cosk:2", "uniform:0.2,0.8,50", dir)) != base);            // the grid
-  CHECK(keyOf(optimalScene("cosk:2", "seed000", dir, EnvmapSampler::Cdf)) != base);   // the sampler
+  CHECK(keyOf(optimalScene("cosk:4", "seed000", dir)) != base);                            // the map
+  CHECK(keyOf(optimalScene("cosk:2", "uniform:0.2,0.8,50", dir)) != base);                 // the grid
+  CHECK(keyOf(optimalScene("cosk:2", "seed000", dir, EnvmapSampler::Cdf)) != base);        // the sampler
   CHECK(keyOf(optimalScene("cosk:2", "seed000", dir, EnvmapSampler::Alias, 30)) != base);  // the view
   OptimalBankOptions coarser;
   coarser.blockLog2 = 4;
   const Scene s = optimalScene("cosk:2", "seed000", dir);
-  CHECK(bankCacheKey(s.envmap, s.options.sampler, s.grid, s.mirror, coarser) != base);  // the bank's options
+  CHECK(bankCacheKey(s.envmap, s.options.sampler, s.grid, flatMirror(s.geometry, "--envmap-pdf optimal"), coarser) !=
+        base);  // the bank's options
 }
 
 TEST_CASE("makeScene reads the bank cache but writes nothing to it", "[bankcache][optimal]") {

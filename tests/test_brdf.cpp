@@ -4,7 +4,7 @@
 // counts with the pdf integrated over each bin. For both lobes (the split-BRDF
 // techniques: sampleDiffuse / diffusePdf, sampleSpecular / specularPdf) and their
 // mixture (the BRDF technique: sampleBrdf / brdfPdf), exponents up to 10⁴, views along
-// the normal and tilted towards the horizon.
+// the normal and tilted towards the horizon, normals along the map's z and tilted.
 #include <fmt/format.h>
 
 #include <array>
@@ -57,18 +57,18 @@ int binOf(const MirrorFrame& f, kern::MaVec3 w) {
 struct Setup {
   Lobe lobe;
   kern::PhongParams brdf;
-  kern::MaVec3 mirror;
+  kern::MaVec3 normal, mirror;
 };
 
 float pdfOf(const Setup& c, kern::MaVec3 w) {
   float lobe = kern::phongLobe(c.brdf, w, c.mirror);
   switch (c.lobe) {
     case Lobe::Diffuse:
-      return kern::diffusePdf(w);
+      return kern::diffusePdf(c.normal, w);
     case Lobe::Specular:
       return kern::specularPdf(c.brdf, lobe);
     default:
-      return kern::brdfPdf(c.brdf, w, lobe);
+      return kern::brdfPdf(c.brdf, c.normal, w, lobe);
   }
 }
 
@@ -76,11 +76,11 @@ kern::MaVec3 sampleOf(const Setup& c, const kern::MaRandom4& rnd) {
   float u1 = kern::uniformFloat(rnd.v[1]), u2 = kern::uniformFloat(rnd.v[2]);
   switch (c.lobe) {
     case Lobe::Diffuse:
-      return kern::sampleDiffuse(u1, u2);
+      return kern::sampleDiffuse(kern::frameAbout(c.normal), u1, u2);
     case Lobe::Specular:
-      return kern::sampleSpecular(c.brdf, c.mirror, u1, u2);
+      return kern::sampleSpecular(c.brdf, kern::frameAbout(c.mirror), u1, u2);
     default:
-      return kern::sampleBrdf(c.brdf, c.mirror, rnd);
+      return kern::sampleBrdf(c.brdf, kern::frameAbout(c.normal), kern::frameAbout(c.mirror), rnd);
   }
 }
 
@@ -96,9 +96,9 @@ std::vector<double> binProbabilities(const Setup& c, const MirrorFrame& f) {
     for (int j = 0; j < kBinsPhi * kSubPhi; ++j) {
       double phi = (j + 0.5) * dphi;
       double lx = std::sin(alpha) * std::cos(phi), ly = std::sin(alpha) * std::sin(phi), lz = std::cos(alpha);
-      kern::MaVec3 w = kern::makeVec3(float(lx * f.t[0] + ly * f.s[0] + lz * f.r[0]),
-                                      float(lx * f.t[1] + ly * f.s[1] + lz * f.r[1]),
-                                      float(lx * f.t[2] + ly * f.s[2] + lz * f.r[2]));
+      kern::MaVec3 w =
+          kern::makeVec3(float(lx * f.t[0] + ly * f.s[0] + lz * f.r[0]), float(lx * f.t[1] + ly * f.s[1] + lz * f.r[1]),
+                         float(lx * f.t[2] + ly * f.s[2] + lz * f.r[2]));
       p[(i / kSubX) * kBinsPhi + j / kSubPhi] += double(pdfOf(c, w)) * weight;
     }
   }
@@ -109,21 +109,27 @@ std::vector<double> binProbabilities(const Setup& c, const MirrorFrame& f) {
 
 TEST_CASE("the BRDF samplers draw directions with the pdfs the estimators use (χ²)", "[brdf][sampler]") {
   const bool small = misalloc::test::smallTestSize();
-  const std::vector<double> views = small ? std::vector<double>{60} : std::vector<double>{0, 45, 80};
+  // (view°, tilted normal): a pixel's frame is the map's (z up) or turned off it.
+  const std::vector<std::pair<double, bool>> views =
+      small ? std::vector<std::pair<double, bool>>{{60, true}}
+            : std::vector<std::pair<double, bool>>{{0, false}, {45, true}, {80, false}};
   const std::vector<double> exponents = small ? std::vector<double>{20, 1e4} : std::vector<double>{1, 20, 1e3, 1e4};
   const uint64_t samples = small ? 200000 : 1000000;
   const std::vector<Lobe> lobes = {Lobe::Diffuse, Lobe::Specular, Lobe::Mixture};
   const int checks = int(views.size() * exponents.size() * lobes.size());
   const double level = misalloc::test::sidakLevel(0.01, checks);
   uint32_t stream = 0;
-  for (double view : views) {
-    // ω_o at `view` from the normal; its mirror direction about z.
-    double theta = view * kPi / 180;
-    kern::MaVec3 mirror = kern::makeVec3(float(-std::sin(theta)), 0.0f, float(std::cos(theta)));
+  for (const auto& [view, tilted] : views) {
+    // ω_o at `view` from the normal; its mirror direction about the normal, in the
+    // normal's frame (the kernel's basis about it).
+    const double theta = view * kPi / 180;
+    const kern::MaVec3 normal =
+        tilted ? kern::makeVec3(2.0f / 7, -3.0f / 7, 6.0f / 7) : kern::makeVec3(0.0f, 0.0f, 1.0f);
+    const kern::MaVec3 mirror = kern::lobeToWorld(normal, float(-std::sin(theta)), 0.0f, float(std::cos(theta)));
     for (double n : exponents) {
       for (Lobe lobe : lobes) {
         // The mixture takes most samples from the Phong lobe, as a glossy pixel does.
-        Setup c{lobe, {0.3f, 0.7f, float(n)}, mirror};
+        Setup c{lobe, {0.3f, 0.7f, float(n)}, normal, mirror};
         MirrorFrame frame = frameOf(mirror);
         std::vector<double> p = binProbabilities(c, frame);
         double total = 0;
@@ -133,8 +139,9 @@ TEST_CASE("the BRDF samplers draw directions with the pdfs the estimators use (�
         for (uint64_t i = 0; i < samples; ++i)
           ++counts[binOf(frame, sampleOf(c, kern::philoxDraw(0xb5df, 0, 0, stream, uint32_t(i))))];
         misalloc::test::ChiSquare test = misalloc::test::chiSquare(counts, p, samples);
-        INFO(fmt::format("{} lobe, n {}, view {}°: pdf integrates to {}, χ² {} with {} degrees of freedom, p {}",
-                         lobeName(lobe), n, view, total, test.statistic, test.degreesOfFreedom, test.pValue()));
+        INFO(fmt::format("{} lobe, n {}, view {}°{}: pdf integrates to {}, χ² {} with {} degrees of freedom, p {}",
+                         lobeName(lobe), n, view, tilted ? " (tilted normal)" : "", total, test.statistic,
+                         test.degreesOfFreedom, test.pValue()));
         // The pdf is a density on the sphere (the specular lobe's part below the
         // horizon included: those samples count and contribute 0).
         CHECK(std::abs(total - 1) < 2e-3);
@@ -148,8 +155,9 @@ TEST_CASE("the BRDF samplers draw directions with the pdfs the estimators use (�
 TEST_CASE("the BRDF χ² test detects a sampler that does not follow its pdf", "[brdf][sampler]") {
   // The same test against the pdf of a lobe one exponent step away fails: it has the
   // power to see the difference between n and 1.05 n at n = 10⁴.
-  kern::MaVec3 mirror = kern::makeVec3(-0.5f, 0.0f, float(std::sqrt(0.75)));
-  Setup sampled{Lobe::Specular, {0.0f, 1.0f, 1e4f}, mirror}, assumed{Lobe::Specular, {0.0f, 1.0f, 1.05e4f}, mirror};
+  kern::MaVec3 normal = kern::makeVec3(0.0f, 0.0f, 1.0f), mirror = kern::makeVec3(-0.5f, 0.0f, float(std::sqrt(0.75)));
+  Setup sampled{Lobe::Specular, {0.0f, 1.0f, 1e4f}, normal, mirror},
+      assumed{Lobe::Specular, {0.0f, 1.0f, 1.05e4f}, normal, mirror};
   MirrorFrame frame = frameOf(mirror);
   std::vector<double> p = binProbabilities(assumed, frame);
   const uint64_t samples = 200000;

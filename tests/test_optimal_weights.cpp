@@ -154,15 +154,16 @@ TEST_CASE("every pdf the optimal weights subtract integrates to 1 over the spher
       const double theta = view * kPi / 180;
       const kern::MaVec3 mirror = kern::makeVec3(float(std::sin(theta)), 0.0f, float(std::cos(theta)));
       kern::PhongParams b{0.3f, 0.7f, float(n)};
+      const kern::MaVec3 up = kern::makeVec3(0.0f, 0.0f, 1.0f);
       double mixture = 0, diffuse = 0, specular = 0;
       for (int i = 0; i < nt; ++i) {
         const double t = (i + 0.5) / nt, d = 2 * std::pow(t, 4), dd = 8 * std::pow(t, 3) / nt;
         for (int j = 0; j < nphi; ++j) {
-          const kern::MaVec3 wi = kern::directionAboutD(mirror, float(d), float((j + 0.5) / nphi));
+          const kern::MaVec3 wi = kern::directionAboutD(kern::frameAbout(mirror), float(d), float((j + 0.5) / nphi));
           const float lobe = kern::phongLobe(b, wi, mirror);
           const double weight = dd * 2 * kPi / nphi;
-          mixture += kern::brdfPdf(b, wi, lobe) * weight;
-          diffuse += kern::diffusePdf(wi) * weight;
+          mixture += kern::brdfPdf(b, up, wi, lobe) * weight;
+          diffuse += kern::diffusePdf(up, wi) * weight;
           specular += kern::specularPdf(b, lobe) * weight;
         }
       }

@@ -78,7 +78,7 @@ TEST_CASE("the product technique draws texels with the probabilities its pdf rea
       for (std::size_t i = 0; i < brdfs.size(); ++i) withBrdfs.grid.pixels[i] = brdfs[i];
       // The scene keeps no copy of the map's image with the plain pdf: read it again.
       const Envmap envmap = makeEnvmap(resolveEnvmapSpec(map), scene.options.proceduralWidth);
-      withBrdfs.productTables = buildProductTables(envmap, withBrdfs.grid, scene.mirror);
+      withBrdfs.productTables = buildProductTables(envmap, withBrdfs.grid, flatMirror(scene.geometry, "--product"));
       withBrdfs.productTables.plainTexels = scene.productTables.plainTexels;
       const kern::EnvmapView env = makeEnvmapView(withBrdfs.tables, -1);
       const kern::ProductView product = makeProductView(withBrdfs.productTables);

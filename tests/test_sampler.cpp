@@ -31,8 +31,10 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 // counts vary, every share. The optimal weights ([Kon19]) run with coefficients of both
 // signs that differ per pixel. A cos^K map takes the analytic radiance of
 // kernels/envmap.h (MA_ANALYTIC_RADIANCE), which every sweep against [HS14] eq. 6.17 runs on the
-// reference. A pairwise covering set of map × pdf × techniques × sampler × sampler
-// configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs every one.
+// reference. Per-pixel frames (normals and views anywhere, tests/SceneFixtures.h) with the
+// pdfs that allow them. A pairwise covering set of map × pdf × techniques × sampler ×
+// frames × sampler configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs
+// every one.
 TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bit for bit", "[sampler]") {
   SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
   shareColumns.shareColumns = true;  // with the optimal pdf
@@ -50,6 +52,7 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     std::string map, pdf;
     int techniques;  // the BRDF as one technique (0), split (1), or with the product (2)
     EnvmapSampler sampler;
+    bool frames;  // per-pixel frames, or the flat scene
     int config;
   };
   std::vector<Case> cases;
@@ -58,15 +61,19 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     for (const std::string pdf : {"plain", "optimal"})
       for (int techniques : {0, 1, 2})
         for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
-          for (int config = 0; config < int(std::size(configs)); ++config) {
-            if (techniques == 1 && pdf == "optimal") continue;  // the optimal pdf takes no split lobes
-            // The product's tables do not depend on the sampler: the CDF sampler with the
-            // optimal pdf's bank adds PoCL compiles to CI, no path.
-            if (techniques == 2 && pdf == "optimal" && s == EnvmapSampler::Cdf) continue;
-            cases.push_back({map, pdf, techniques, s, config});
-            settings.push_back({"map=" + map, "pdf=" + pdf, fmt::format("techniques={}", techniques),
-                                fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("config={}", config)});
-          }
+          for (bool frames : {false, true})
+            for (int config = 0; config < int(std::size(configs)); ++config) {
+              if (techniques == 1 && pdf == "optimal") continue;  // the optimal pdf takes no split lobes
+              // The product's tables do not depend on the sampler: the CDF sampler with the
+              // optimal pdf's bank adds PoCL compiles to CI, no path.
+              if (techniques == 2 && pdf == "optimal" && s == EnvmapSampler::Cdf) continue;
+              // The optimal pdf's bank and the product's tables are built for one frame.
+              if (frames && (pdf == "optimal" || techniques == 2)) continue;
+              cases.push_back({map, pdf, techniques, s, frames, config});
+              settings.push_back({"map=" + map, "pdf=" + pdf, fmt::format("techniques={}", techniques),
+                                  fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("frames={}", frames),
+                                  fmt::format("config={}", config)});
+            }
   std::vector<size_t> chosen(cases.size());
   for (size_t i = 0; i < cases.size(); ++i) chosen[i] = i;
   if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
@@ -74,7 +81,8 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     const Case& cs = cases[c];
     const SamplerConfig& config = configs[cs.config];
     const bool split = cs.techniques == 1, product = cs.techniques == 2;
-    const Scene scene = smallScene(cs.map, "seed000", 24, 16, split, cs.sampler, 0, cs.pdf, product);
+    Scene scene = smallScene(cs.map, "seed000", 24, 16, split, cs.sampler, 0, cs.pdf, product);
+    if (cs.frames) giveRandomFrames(scene, 3);
     if (cs.pdf == "optimal") REQUIRE(scene.tables.brdfBins > 1);
     StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
     // Counts that differ from pixel to pixel, each technique at least one: work-groups
@@ -116,9 +124,9 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
     REQUIRE(storedA.size() == storedB.size());
     for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
-    INFO(fmt::format("{} {} split {} product {} cdf {} estimator {} stats {} stored {} optimal weights {}", cs.map,
-                     cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, int(config.estimator), config.statsMask,
-                     config.sampleCapacity, config.optimalWeights));
+    INFO(fmt::format("{} {} split {} product {} cdf {} frames {} estimator {} stats {} stored {} optimal weights {}",
+                     cs.map, cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, cs.frames, int(config.estimator),
+                     config.statsMask, config.sampleCapacity, config.optimalWeights));
     CHECK(mismatches == 0);
   }
 }

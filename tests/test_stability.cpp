@@ -166,7 +166,7 @@ TEST_CASE("the Phong lobe and its sampler keep float precision up to n = 1e5", "
     for (int i = 0; i < N; ++i) {
       // The kernel's 24-bit uniforms.
       float u1 = kern::uniformFloat(engine()), u2 = kern::uniformFloat(engine());
-      kern::MaVec3 w = kern::sampleSpecular(b, mirror, u1, u2);
+      kern::MaVec3 w = kern::sampleSpecular(b, kern::frameAbout(mirror), u1, u2);
       // cos α of the float vectors in double, normalising both.
       double wx = w.x, wy = w.y, wz = w.z, mx = mirror.x, my = mirror.y, mz = mirror.z;
       double wn = std::sqrt(wx * wx + wy * wy + wz * wz), mn = std::sqrt(mx * mx + my * my + mz * mz);

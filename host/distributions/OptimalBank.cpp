@@ -86,6 +86,7 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
   std::vector<double> compensatedRatio(bank.entries.size(), 1);
   std::vector<char> negative(bank.entries.size(), 0);
   const kern::MaVec3 r = kern::makeVec3(mirror[0], mirror[1], mirror[2]);
+  const kern::MaVec3 up = kern::makeVec3(0.0f, 0.0f, 1.0f);  // a flat scene's normal (flatMirror)
 #pragma omp parallel for schedule(dynamic, 1)
   for (int bin = 0; bin < binCount; ++bin) {
     kern::PhongParams b;
@@ -96,8 +97,8 @@ OptimalBankWeights optimalBlockWeights(const std::vector<double>& plainWeights, 
     std::vector<double> f(blocks, 0.0), brdf(blocks, 0.0);
     for (const BlockCell& cell : grid.cells) {
       const float lobe = kern::phongLobe(b, cell.direction, r);
-      f[cell.block] += cell.plain * kern::phongBrdf(b, lobe) * std::max(cell.direction.z, 0.0f);
-      brdf[cell.block] += cell.solidAngle * kern::brdfPdf(b, cell.direction, lobe);
+      f[cell.block] += cell.plain * kern::phongBrdf(b, lobe) * kern::cosAboveSurface(up, cell.direction);
+      brdf[cell.block] += cell.solidAngle * kern::brdfPdf(b, up, cell.direction, lobe);
     }
     double F = 0;
     for (double v : f) F += v;

@@ -26,7 +26,9 @@ constexpr uint64_t kReferenceSeed = 0x8000000000005eedull;
 
 std::optional<RgbImage> analyticReference(const Scene& scene) {
   const float K = scene.envmap.coskExponent;
-  if (K < 0 || scene.options.viewTheta != 0) return std::nullopt;
+  // Eq. 6.17 holds for a view along the normal, and the cos^K map about it.
+  if (K < 0 || !scene.geometry.flat() || scene.geometry.pixels.front().mirror != Vec3f{0.0f, 0.0f, 1.0f})
+    return std::nullopt;
   RgbImage image;
   image.width = scene.grid.width;
   image.height = scene.grid.height;
@@ -106,6 +108,8 @@ std::string referenceKey(const Scene& scene, int spp) {
   h.addValue(scene.grid.height);
   h.addValue(scene.options.viewTheta);
   h.addValue(scene.options.viewPhi);
+  // Per-pixel frames: every one of them (a flat scene's are the view above).
+  if (!scene.geometry.flat()) h.add(scene.geometry.pixels.data(), scene.geometry.pixels.size() * sizeof(PixelFrame));
   h.addValue(spp);
   h.add(referenceEstimator(scene.options));
   return fmt::format("{:016x}", h.h);

@@ -44,7 +44,9 @@ kern::ShadingPoint makeShadingPoint(const Scene& scene, int pixel) {
   sp.brdf.rhoD = p.rhoD;
   sp.brdf.rhoS = p.rhoS;
   sp.brdf.n = p.n;
-  sp.mirror = kern::makeVec3(scene.mirror[0], scene.mirror[1], scene.mirror[2]);
+  const PixelFrame& f = scene.geometry.pixels[pixel];
+  sp.normalFrame = kern::frameAbout(kern::makeVec3(f.normal[0], f.normal[1], f.normal[2]));
+  sp.mirrorFrame = kern::frameAbout(kern::makeVec3(f.mirror[0], f.mirror[1], f.mirror[2]));
   return sp;
 }
 

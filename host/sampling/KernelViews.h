@@ -11,7 +11,7 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& tables, float coskExponent);
 
 kern::ProductView makeProductView(const ProductTables& tables);
 
-// Pixel p of the scene as the point it shades: its BRDF and the scene's mirror direction.
+// Pixel p of the scene as the point it shades: its BRDF, normal and mirror direction.
 kern::ShadingPoint makeShadingPoint(const Scene& scene, int pixel);
 
 }  // namespace misalloc

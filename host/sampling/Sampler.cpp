@@ -9,6 +9,7 @@
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
 #include "cl/LaunchShape.h"
+#include "sampling/KernelViews.h"
 #include "sampling/LaunchWork.h"
 
 namespace misalloc {
@@ -38,6 +39,13 @@ void writeSums(const Device& d, const cl::Buffer& buffer, const std::vector<doub
 std::vector<float> withSpareRecord(std::vector<float> samples, const Scene& scene, const SamplerConfig& config) {
   samples.resize(samples.size() + size_t(MA_SAMPLE_RECORD_FLOATS(sampleColumns(scene, config).count())) * 16, 0.0f);
   return samples;
+}
+
+// A frame's axis as kernels/sample.cl reads it (frameOfRows): x, y, z.
+void writeVec3(const kern::MaVec3& v, float* w) {
+  w[0] = v.x;
+  w[1] = v.y;
+  w[2] = v.z;
 }
 
 }  // namespace
@@ -71,13 +79,19 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
   blockProbs = upload(device, t.blockProbs);
   productFloats = upload(device, scene.productTables.floats);
   productWords = upload(device, scene.productTables.words);
-  std::vector<float> params;
-  params.reserve(size_t(kern::brdfOffset(int(scene.grid.pixels.size()))));
-  for (std::size_t p = 0; p < scene.grid.pixels.size(); ++p) {
-    const PhongParameters& b = scene.grid.pixels[p];
-    params.insert(params.end(), {b.rhoD, b.rhoS, b.n, t.hasBank() ? float(t.brdfBinOfPixel[p]) : 0.0f});
+  // The kernel's shading point rows (kernels/pixel_layout.h), from the reference's.
+  std::vector<float> words(size_t(kern::shadingPointOffset(scene.pixelCount())));
+  for (int p = 0; p < scene.pixelCount(); ++p) {
+    const kern::ShadingPoint sp = makeShadingPoint(scene, p);
+    float* w = words.data() + kern::shadingPointOffset(p);
+    w[kern::ROW_RHO_D] = sp.brdf.rhoD;
+    w[kern::ROW_RHO_S] = sp.brdf.rhoS;
+    w[kern::ROW_N] = sp.brdf.n;
+    w[kern::ROW_BRDF_BIN] = t.hasBank() ? float(t.brdfBinOfPixel[size_t(p)]) : 0.0f;
+    writeVec3(sp.normalFrame.z, w + kern::ROW_NORMAL_X);
+    writeVec3(sp.mirrorFrame.z, w + kern::ROW_MIRROR_X);
   }
-  brdfParams = upload(device, params);
+  shadingPoints = upload(device, words);
 }
 
 Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize,
@@ -167,10 +181,10 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
       bindKernelArgs(kernel, args...);
   };
   bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, b.productFloats, b.productWords, cl_int(scene_.tables.width),
-       cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.brdfParams, scene_.mirror[0],
-       scene_.mirror[1], scene_.mirror[2], counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu),
-       cl_uint(seed >> 32), cl_int(scene_.firstPixel), cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_,
-       samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
+       cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints, counts_, firstIndex_,
+       cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
+       cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
+       cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
   const size_t global = lanes > 0 ? size_t(range.size()) * lanes : (size_t(range.size()) + local - 1) / local * local;

@@ -30,7 +30,7 @@ class SceneBuffers {
   SceneBuffers(const Device& device, const Scene& scene);
   cl_context context() const { return context_; }
 
-  cl::Buffer texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, brdfParams;
+  cl::Buffer texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, shadingPoints;
 
  private:
   cl_context context_;

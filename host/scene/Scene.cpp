@@ -73,9 +73,14 @@ EnvmapSampler parseEnvmapSampler(const std::string& name) {
   throw InputError(fmt::format("--envmap-sampler '{}': expected alias or cdf", name));
 }
 
+const Vec3f& flatMirror(const SceneGeometry& geometry, const std::string& option) {
+  if (!geometry.flat())
+    throw InputError(fmt::format(
+        "{} with per-pixel normals or views: not implemented; its tables are built for one normal and view", option));
+  return geometry.pixels.front().mirror;
+}
+
 Scene makeScene(const SceneOptions& options) {
-  if (!(options.viewTheta >= 0 && options.viewTheta < 90))
-    throw InputError(fmt::format("--view {}: the view's polar angle must lie in [0, 90) degrees", options.viewTheta));
   if (options.product && options.splitBrdf)
     throw InputError(
         "--product with --split-brdf: not implemented; the kernels take at most 3 techniques (MA_MAX_TECHNIQUES), "
@@ -83,12 +88,10 @@ Scene makeScene(const SceneOptions& options) {
   Scene scene;
   scene.options = options;
   scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
+  scene.geometry = planeGeometry(options.width, options.height, options.viewTheta, options.viewPhi);
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
-  double t = options.viewTheta * M_PI / 180, p = options.viewPhi * M_PI / 180;
-  // ω_r = 2(n·ω_o)n − ω_o with n = z.
-  scene.mirror = {float(-std::sin(t) * std::cos(p)), float(-std::sin(t) * std::sin(p)), float(std::cos(t))};
   if (options.envmapPdf.optimal()) {
     // q = (1−C) p_ρ of [Kar19] eq. 9 takes the BRDF as one technique; split into lobes,
     // q would depend on the lobes' shares too.
@@ -96,22 +99,23 @@ Scene makeScene(const SceneOptions& options) {
       throw InputError(
           "--envmap-pdf optimal with --split-brdf: not implemented; the optimal pdf's bank is built "
           "for the BRDF as one technique (M = 2)");
+    const Vec3f& mirror = flatMirror(scene.geometry, "--envmap-pdf optimal");
     std::optional<EnvmapTables> cached;
     if (!options.bankCacheDir.empty()) {
       const auto start = std::chrono::steady_clock::now();
-      scene.bankCacheKey = bankCacheKey(scene.envmap, options.sampler, scene.grid, scene.mirror);
+      scene.bankCacheKey = bankCacheKey(scene.envmap, options.sampler, scene.grid, mirror);
       cached = readCachedBank(options.bankCacheDir, scene.bankCacheKey, scene.envmap.image);
       // A hit costs its key (every texel hashed) and its read.
       if (cached)
         cached->bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
     scene.tables =
-        cached ? std::move(*cached) : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, scene.mirror);
+        cached ? std::move(*cached) : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, mirror);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
   if (options.product) {
-    scene.productTables = buildProductTables(scene.envmap, scene.grid, scene.mirror);
+    scene.productTables = buildProductTables(scene.envmap, scene.grid, flatMirror(scene.geometry, "--product"));
     const EnvmapTables& t = scene.tables;
     scene.productTables.plainTexels = t.pdf.plain() && !t.hasBank() && !t.useCdf;
   }

@@ -7,6 +7,7 @@
 #include "distributions/ProductTables.h"
 #include "scene/BrdfGrid.h"
 #include "scene/Envmap.h"
+#include "scene/SceneGeometry.h"
 
 namespace misalloc {
 
@@ -14,7 +15,7 @@ struct SceneOptions {
   std::string envmap = "forest_slope";  // a path, a shipped map's name, or a procedural spec
   std::string grid = "seed000";
   int width = 128, height = 128;
-  double viewTheta = 0, viewPhi = 0;  // ω_o in degrees; the normal is z
+  double viewTheta = 0, viewPhi = 0;  // the plane's ω_o in degrees (planeGeometry)
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
   bool product = false;               // M = 3: envmap × BRDF × cos as a third technique (--product)
   EnvmapSampler sampler = EnvmapSampler::Alias;
@@ -43,7 +44,7 @@ struct Scene {
   EnvmapTables tables;
   ProductTables productTables;  // --product; none otherwise
   BrdfGrid grid;
-  std::array<float, 3> mirror;  // mirror direction of ω_o about the normal
+  SceneGeometry geometry;       // each pixel's normal and mirror direction
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
   std::string bankCacheKey;     // where the optimal pdf's tables were looked up in SceneOptions::bankCacheDir
   // The image's index of pixel 0: 0 for a whole image; a band of an image's rows
@@ -55,6 +56,10 @@ struct Scene {
   int pixelCount() const { return grid.width * grid.height; }
   std::vector<std::string> techniqueNames() const;
 };
+
+// The one mirror direction of a flat scene, for which the optimal pdf's bank and the
+// product tables are built; throws InputError naming `option` for any other geometry.
+const Vec3f& flatMirror(const SceneGeometry& geometry, const std::string& option);
 
 // Builds the scene, reading the optimal pdf's tables from SceneOptions::bankCacheDir
 // where they are cached there.
