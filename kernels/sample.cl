@@ -278,9 +278,10 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 // each sample's terms go to local memory in float, and lane 0 adds a chunk of them in
 // the C++ reference's order (addContribution), which keeps the sums bit for bit its sums.
 // Statistics and stored samples stay with sampleStage.
+//
 // The pixel's rows two words apart: LLVM's SLP vectoriser loads adjacent rows (the
 // normal's x, y, z) as 2-wide vectors and pairs the terms of its basis, which keeps the
-// sample loop scalar (docs/pocl.md, rule 8): 2.6x the time of the whole stage.
+// sample loop scalar (docs/pocl.md, rule 8): twice the time of the whole stage.
 #define PIXEL_ROW_STRIDE 2
 #define PASSES_PER_CHUNK 8
 #define CHUNK_SAMPLES (PASSES_PER_CHUNK * MA_PIXEL_LANES)
