@@ -81,8 +81,6 @@ MA_FN MaVec3 frameToWorld(MaFrame f, float x, float y, float z) {
                   x * f.t.z + y * f.s.z + z * f.z.z);
 }
 
-MA_FN MaVec3 lobeToWorld(MaVec3 axis, float x, float y, float z) { return frameToWorld(frameAbout(axis), x, y, z); }
-
 // A direction about the frame's z with cos = cosAlpha and azimuth 2πu.
 MA_FN MaVec3 directionAbout(MaFrame f, float cosAlpha, float u) {
   float sinAlpha = ma_sqrt(ma_max((1.0f - cosAlpha) * (1.0f + cosAlpha), 0.0f));

@@ -12,9 +12,9 @@
 enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, SUM_COUNT };
 
 // What a pixel's samples share, one 32-bit word per row: its shading point (BRDF, BRDF
-// bin, normal, mirror direction), counts and first sample indices; then, with --weights optimal, the coefficients
-// a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with --product, its ProductMixture (diffuse, specular, specular
-// table).
+// bin, normal, mirror direction), counts and first sample indices; then, with --weights
+// optimal, the coefficients a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with
+// --product, its ProductMixture (diffuse, specular, specular table).
 enum {
   ROW_RHO_D,
   ROW_RHO_S,

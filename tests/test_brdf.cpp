@@ -39,8 +39,8 @@ constexpr int kBinsX = 48, kBinsPhi = 24;
 
 MirrorFrame frameOf(kern::MaVec3 mirror) {
   // The kernel's own basis about r, in double.
-  kern::MaVec3 t = kern::lobeToWorld(mirror, 1, 0, 0), s = kern::lobeToWorld(mirror, 0, 1, 0);
-  return {{t.x, t.y, t.z}, {s.x, s.y, s.z}, {mirror.x, mirror.y, mirror.z}};
+  const kern::MaFrame f = kern::frameAbout(mirror);
+  return {{f.t.x, f.t.y, f.t.z}, {f.s.x, f.s.y, f.s.z}, {mirror.x, mirror.y, mirror.z}};
 }
 
 int binOf(const MirrorFrame& f, kern::MaVec3 w) {
@@ -125,7 +125,8 @@ TEST_CASE("the BRDF samplers draw directions with the pdfs the estimators use (Ï
     const double theta = view * kPi / 180;
     const kern::MaVec3 normal =
         tilted ? kern::makeVec3(2.0f / 7, -3.0f / 7, 6.0f / 7) : kern::makeVec3(0.0f, 0.0f, 1.0f);
-    const kern::MaVec3 mirror = kern::lobeToWorld(normal, float(-std::sin(theta)), 0.0f, float(std::cos(theta)));
+    const kern::MaVec3 mirror =
+        kern::frameToWorld(kern::frameAbout(normal), float(-std::sin(theta)), 0.0f, float(std::cos(theta)));
     for (double n : exponents) {
       for (Lobe lobe : lobes) {
         // The mixture takes most samples from the Phong lobe, as a glossy pixel does.

@@ -52,7 +52,6 @@ Scene bandScene(Scene image, RowRange rows) {
   image.firstPixel += int(size_t(rows.begin) * width);
   image.grid.height = rows.size();
   image.grid.pixels = rowsOf(image.grid.pixels, width, 0, rows);
-  image.geometry.height = rows.size();
   image.geometry.pixels = rowsOf(image.geometry.pixels, width, 0, rows);
   image.options.height = rows.size();
   if (image.tables.hasBank()) image.tables.brdfBinOfPixel = rowsOf(image.tables.brdfBinOfPixel, width, 0, rows);

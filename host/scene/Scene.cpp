@@ -88,7 +88,7 @@ Scene makeScene(const SceneOptions& options) {
   Scene scene;
   scene.options = options;
   scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
-  scene.geometry = planeGeometry(options.width, options.height, options.viewTheta, options.viewPhi);
+  scene.geometry = planeGeometry(scene.pixelCount(), options.viewTheta, options.viewPhi);
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);

@@ -20,17 +20,14 @@ Vec3f mirrorDirection(const Vec3f& n, const Vec3f& v) {
   return {float(d * n[0] - v[0]), float(d * n[1] - v[1]), float(d * n[2] - v[2])};
 }
 
-SceneGeometry planeGeometry(int width, int height, double viewThetaDegrees, double viewPhiDegrees) {
+SceneGeometry planeGeometry(int pixels, double viewThetaDegrees, double viewPhiDegrees) {
   if (!(viewThetaDegrees >= 0 && viewThetaDegrees < 90))
     throw InputError(fmt::format("--view {}: the view's polar angle must lie in [0, 90) degrees", viewThetaDegrees));
   const double t = viewThetaDegrees * M_PI / 180, p = viewPhiDegrees * M_PI / 180;
-  // ω_r = 2(n·ω_o)n − ω_o with n = z, in closed form: the flat scene's mirror direction
-  // is exactly what it was before there were per-pixel frames.
-  const Vec3f mirror{float(-std::sin(t) * std::cos(p)), float(-std::sin(t) * std::sin(p)), float(std::cos(t))};
+  const Vec3f up{0.0f, 0.0f, 1.0f};
+  const Vec3f view{float(std::sin(t) * std::cos(p)), float(std::sin(t) * std::sin(p)), float(std::cos(t))};
   SceneGeometry g;
-  g.width = width;
-  g.height = height;
-  g.pixels.assign(size_t(width) * size_t(height), PixelFrame{{0.0f, 0.0f, 1.0f}, mirror});
+  g.pixels.assign(size_t(pixels), PixelFrame{up, mirrorDirection(up, view)});
   return g;
 }
 

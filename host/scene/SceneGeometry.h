@@ -16,8 +16,7 @@ struct PixelFrame {
 // Where every pixel's shading point faces and how it is seen: the surface under the
 // BRDF grid.
 struct SceneGeometry {
-  int width = 0, height = 0;
-  std::vector<PixelFrame> pixels;  // row-major, row 0 at the top
+  std::vector<PixelFrame> pixels;  // row-major as the BRDF grid, row 0 at the top
 
   // [HS14] Sec. 5.2's scene: every pixel's normal is z and its view the same. The
   // optimal pdf's bank and the product tables are built for that one frame.
@@ -27,8 +26,8 @@ struct SceneGeometry {
 // The mirror direction of ω_o about n, 2(n·ω_o)n − ω_o, for unit n and ω_o.
 Vec3f mirrorDirection(const Vec3f& normal, const Vec3f& view);
 
-// A plane (normal z) seen from ω_o at polar angle θ and azimuth φ (degrees) at every
-// pixel, as by a distant camera. Throws InputError where θ is not in [0, 90).
-SceneGeometry planeGeometry(int width, int height, double viewThetaDegrees, double viewPhiDegrees);
+// A plane (normal z) seen from ω_o at polar angle θ and azimuth φ (degrees) at each of
+// its pixels, as by a distant camera. Throws InputError where θ is not in [0, 90).
+SceneGeometry planeGeometry(int pixels, double viewThetaDegrees, double viewPhiDegrees);
 
 }  // namespace misalloc
