@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "TestSize.h"
+
 namespace misalloc::test {
 
 using Configuration = std::vector<std::string>;  // settings "name=value"
@@ -58,6 +60,15 @@ inline std::vector<size_t> pairwiseCovering(const std::vector<Configuration>& co
   }
   std::sort(chosen.begin(), chosen.end());
   return chosen;
+}
+
+// The configurations a test runs: a pairwise covering set, or with
+// MISALLOC_TEST_SIZE=exhaustive (scripts/exhaustive-tests) every one.
+inline std::vector<size_t> configurationsToRun(const std::vector<Configuration>& configurations) {
+  if (!exhaustiveTestSize()) return pairwiseCovering(configurations);
+  std::vector<size_t> all(configurations.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return all;
 }
 
 }  // namespace misalloc::test

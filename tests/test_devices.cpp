@@ -110,12 +110,9 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
       }
   // Pairwise (tests/Covering.h): every method with every estimator, device pair and M;
   // small test size (the sanitizers): of M = 3, equal and exact only.
-  std::vector<size_t> chosen(cases.size());
-  for (size_t i = 0; i < chosen.size(); ++i) chosen[i] = i;
-  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
   SamplerDevices one("cpu");
   std::map<std::string, std::unique_ptr<SamplerDevices>> pairs;
-  for (size_t i : chosen) {
+  for (size_t i : configurationsToRun(settings)) {
     const Case& c = cases[i];
     if (smallTestSize() && c.scene == &three && c.method != Method::Equal && c.method != Method::Exact) continue;
     auto& pair = pairs[*c.list];

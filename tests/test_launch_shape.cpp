@@ -134,9 +134,7 @@ TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the b
           settings.push_back({fmt::format("techniques={}", techniques), fmt::format("method={}", method),
                               fmt::format("optimal={}", optimal), fmt::format("local={}", localSize)});
         }
-  std::vector<size_t> chosen(cases.size());
-  for (size_t i = 0; i < cases.size(); ++i) chosen[i] = i;
-  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
+  const std::vector<size_t> chosen = configurationsToRun(settings);
   const Device& device = testDevice();
   const bool doubleSums = hasFp64(device.device);
   for (size_t c : chosen) {

@@ -74,9 +74,7 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
                                   fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("frames={}", frames),
                                   fmt::format("config={}", config)});
             }
-  std::vector<size_t> chosen(cases.size());
-  for (size_t i = 0; i < cases.size(); ++i) chosen[i] = i;
-  if (!exhaustiveTestSize()) chosen = pairwiseCovering(settings);
+  const std::vector<size_t> chosen = configurationsToRun(settings);
   for (size_t c : chosen) {
     const Case& cs = cases[c];
     const SamplerConfig& config = configs[cs.config];
