@@ -40,6 +40,10 @@ MA_FN StageCounts loadStageCounts(MA_GLOBAL const int* counts, MA_GLOBAL const m
   return c;
 }
 
+// How many samples the pixel takes this stage: N, or 0 for the background, which takes
+// none (host/render/Method.h, leaveOutBackground).
+MA_FN int pixelStageSamples(StageCounts c) { return c.n0 + c.n1 + c.n2; }
+
 // The index of `technique`'s first sample this stage (its random-number stream).
 MA_FN ma_uint firstIndexOf(StageCounts c, int technique) {
   return technique == 0 ? c.first0 : (technique == 1 ? c.first1 : c.first2);

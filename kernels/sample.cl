@@ -88,6 +88,13 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #undef PIXEL_ROW
 }
 
+// The one-sample estimator's pass: the stage's samples, none for the background
+// (pixelStageSamples).
+MA_FN int oneSamplePassSamples(__local const int* pixelRows, int rowStride, int column) {
+  return pixelRows[ROW_N0 * rowStride + column] + pixelRows[ROW_N1 * rowStride + column] +
+         pixelRows[ROW_N2 * rowStride + column];
+}
+
 // The unit vector at rows row, row + 1, row + 2, and the basis about it.
 MA_FN MaFrame frameOfRows(__local const int* pixelRows, int rowStride, int column, int row) {
 #define ROW_FLOAT(r) as_float(pixelRows[(row + (r)) * rowStride + column])
@@ -208,7 +215,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   int start = 0;  // the pass's first sample in the stage
   MA_UNROLL
   for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
-    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[(ROW_N0 + k) * MA_LOCAL_SIZE + lid];
+    int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid)
+                          : pixelRows[(ROW_N0 + k) * MA_LOCAL_SIZE + lid];
     passCounts[lid] = n;
     barrier(CLK_LOCAL_MEM_FENCE);
     int passSamples = 0;
@@ -316,7 +324,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
   barrier(CLK_LOCAL_MEM_FENCE);
   MA_UNROLL
   for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
-    int n = MA_ONE_SAMPLE ? stageSamples : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
+    int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
+                          : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
     for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
       int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
       for (int p = 0; p < passes; ++p) {

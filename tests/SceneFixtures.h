@@ -66,6 +66,11 @@ inline void giveRandomFrames(Scene& scene, uint32_t key) {
   }
 }
 
+// Every `period`-th pixel, from pixel 1, made background (SceneGeometry::covered).
+inline void giveBackground(Scene& scene, int period) {
+  for (size_t p = 1; p < scene.geometry.covered.size(); p += size_t(period)) scene.geometry.covered[p] = 0;
+}
+
 // The sampler of the statistical sweeps: the C++ reference, which computes the kernel's
 // floats bit for bit on every path the sweeps take (tests/test_sampler.cpp), so that a
 // sweep tests the estimator and not PoCL, and compiles no kernel per scene. With

@@ -4,17 +4,17 @@
 #include <unistd.h>
 
 #include <array>
-#include <cstring>
 #include <catch2/catch.hpp>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "Error.h"
 #include "CliRunner.h"
+#include "Error.h"
 #include "RawExr.h"
 #include "TestDevice.h"
 #include "cl/Device.h"
@@ -42,6 +42,34 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   CHECK(j["rmse_x1000"].get<double>() > 0);
   CHECK(j["time_s"]["kernel"].get<double>() > 0);
   CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());
+}
+
+TEST_CASE("render --scene spheres writes the background transparent black, and reports its pdf and coverage",
+          "[cli][scenes]") {
+  TempDir dir;
+  auto out = dir.path / "s.exr", report = dir.path / "s.json";
+  auto r =
+      runMisalloc(fmt::format("render --scene spheres:2x2 --envmap cosk:1 --size 16x16 --spp 16 --device cpu "
+                              "--reference-spp 64 --out {} --report {} --cache-dir {}",
+                              out.string(), report.string(), (dir.path / "cache").string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  const misalloc::RgbImage image = misalloc::readExr(out.string());
+  REQUIRE(image.alpha.size() == 256);
+  size_t covered = 0, blackBackground = 0;
+  for (size_t p = 0; p < 256; ++p) {
+    covered += image.alpha[p] == 1;
+    blackBackground +=
+        image.alpha[p] == 0 && image.rgb[3 * p] == 0 && image.rgb[3 * p + 1] == 0 && image.rgb[3 * p + 2] == 0;
+  }
+  CHECK(covered > 100);
+  CHECK(covered + blackBackground == 256);
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  CHECK(j["scene"]["shape"] == "spheres:2x2");
+  CHECK(j["scene"]["covered_pixels"] == covered);
+  CHECK(j["scene"]["view_deg"][0] == 75.0);
+  CHECK(j["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
+  CHECK(j["reference"]["source"].get<std::string>().find("compensated:0.5") != std::string::npos);
 }
 
 TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
@@ -75,6 +103,11 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--envmap-sampler tree", "--envmap-sampler 'tree'"},
       {"--view 95", "--view 95"},
       {"--envmap cosk:x", "cosk:x"},
+      {"--scene cube", "unknown --scene 'cube'"},
+      {"--scene spheres:0x2", "--scene spheres:0x2"},
+      {"--scene sphere --view 200", "--view 200"},
+      {"--scene sphere --envmap-pdf optimal", "--envmap-pdf optimal with per-pixel normals or views: not implemented"},
+      {"--scene sphere --product", "--product with per-pixel normals or views: not implemented"},
   };
   for (const Case& c : cases) {
     auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 {} {}", outputs, c.args));
@@ -96,7 +129,8 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::ofstream(file("cut.exr"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   }
-  misalloc::writeExrChannels(file("rg.exr"), 4, 2, {"R", "G"}, {std::vector<float>(8, 1.0f), std::vector<float>(8, 1.0f)});
+  misalloc::writeExrChannels(file("rg.exr"), 4, 2, {"R", "G"},
+                             {std::vector<float>(8, 1.0f), std::vector<float>(8, 1.0f)});
   {
     // OpenEXR cannot write an empty data window: patch max.x of a good file's below min.x.
     misalloc::writeExr(file("good.exr"), misalloc::RgbImage{4, 2, std::vector<float>(24, 1.0f)});

@@ -34,7 +34,6 @@ using misalloc::RgbImage;
 
 namespace {
 
-
 // A fresh folder for one test case, removed with its contents afterwards.
 struct ScratchDir {
   fs::path path;
@@ -103,15 +102,26 @@ TEST_CASE("writeExr and readExr round-trip float RGB exactly", "[exr]") {
   CHECK(back.width == 7);
   CHECK(back.height == 5);
   CHECK(back.rgb == image.rgb);
+  CHECK(back.alpha.empty());
+  // With coverage, its alpha as channel A.
+  image.alpha.assign(35, 1.0f);
+  image.alpha[3] = 0.0f;
+  misalloc::writeExr(dir / "b.exr", image);
+  back = readExr(dir / "b.exr");
+  CHECK(back.rgb == image.rgb);
+  CHECK(back.alpha == image.alpha);
+  CHECK(back.coveredPixels() == 34);
 }
 
-TEST_CASE("readExr reads half RGB and RGBA as float, ignores alpha, and honours the data window", "[exr]") {
+TEST_CASE("readExr reads half RGB and RGBA as float, alpha too, and honours the data window", "[exr]") {
   ScratchDir dir("half");
   RgbImage image = testImage(6, 4);
   auto planes = planesOf(image);
   SECTION("half RGB") { writeRawExr(dir / "h.exr", 6, 4, {"R", "G", "B"}, planes, Imf::HALF); }
+  std::vector<float> alpha;
   SECTION("half RGBA") {
-    planes.push_back(std::vector<float>(24, 0.5f));
+    alpha.assign(24, 0.5f);
+    planes.push_back(alpha);
     writeRawExr(dir / "h.exr", 6, 4, {"R", "G", "B", "A"}, planes, Imf::HALF);
   }
   SECTION("float RGB, data window not at the origin") {
@@ -121,6 +131,23 @@ TEST_CASE("readExr reads half RGB and RGBA as float, ignores alpha, and honours 
   CHECK(back.width == 6);
   CHECK(back.height == 4);
   CHECK(back.rgb == image.rgb);
+  CHECK(back.alpha == alpha);
+}
+
+TEST_CASE("readExr places alpha with the data window, transparent outside it, and refuses alpha off [0, 1]", "[exr]") {
+  ScratchDir dir("alpha");
+  RgbImage data = testImage(3, 2);
+  auto planes = planesOf(data);
+  planes.push_back(std::vector<float>(6, 1.0f));
+  writeRawExr(dir / "a.exr", 3, 2, {"R", "G", "B", "A"}, planes, Imf::FLOAT, 1, 1, Imath::Box2i({0, 0}, {4, 3}));
+  RgbImage back = readExr(dir / "a.exr");
+  REQUIRE(back.alpha.size() == 20);
+  CHECK(back.coveredPixels() == 6);
+  CHECK(back.alpha[0] == 0.0f);
+  CHECK(back.alpha[1 * 5 + 1] == 1.0f);
+  planes.back()[4] = 1.5f;
+  writeRawExr(dir / "b.exr", 3, 2, {"R", "G", "B", "A"}, planes, Imf::FLOAT);
+  CHECK_THROWS_WITH(readExr(dir / "b.exr"), Catch::Contains("its alpha at x=1, y=1 is 1.5"));
 }
 
 TEST_CASE("readExr places the data window in the display window, the texels outside it black", "[exr]") {

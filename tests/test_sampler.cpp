@@ -32,9 +32,9 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 // signs that differ per pixel. A cos^K map takes the analytic radiance of
 // kernels/envmap.h (MA_ANALYTIC_RADIANCE), which every sweep against [HS14] eq. 6.17 runs on the
 // reference. Per-pixel frames (normals and views anywhere, tests/SceneFixtures.h) with the
-// pdfs that allow them. A pairwise covering set of map × pdf × techniques × sampler ×
-// frames × sampler configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs
-// every one.
+// pdfs that allow them, and background pixels among them, which take no samples. A pairwise covering set of map × pdf ×
+// techniques × sampler × frames × sampler configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs every
+// one.
 TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bit for bit", "[sampler]") {
   SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
   shareColumns.shareColumns = true;  // with the optimal pdf
@@ -52,7 +52,7 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     std::string map, pdf;
     int techniques;  // the BRDF as one technique (0), split (1), or with the product (2)
     EnvmapSampler sampler;
-    bool frames;  // per-pixel frames, or the flat scene
+    bool frames;  // per-pixel frames with background pixels among them, or the flat scene
     int config;
   };
   std::vector<Case> cases;
@@ -80,7 +80,10 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     const SamplerConfig& config = configs[cs.config];
     const bool split = cs.techniques == 1, product = cs.techniques == 2;
     Scene scene = smallScene(cs.map, "seed000", 24, 16, split, cs.sampler, 0, cs.pdf, product);
-    if (cs.frames) giveRandomFrames(scene, 3);
+    if (cs.frames) {
+      giveRandomFrames(scene, 3);
+      giveBackground(scene, 5);
+    }
     if (cs.pdf == "optimal") REQUIRE(scene.tables.brdfBins > 1);
     StagePlan plan = singleStagePlan(scene, Method::Equal, 50);
     // Counts that differ from pixel to pixel, each technique at least one: work-groups
@@ -92,6 +95,7 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
       n[M - 1] = 50 - n[0] - (M - 2) * (1 + p % 3);
       if (M == 3) n[1] = 1 + p % 3;
     }
+    leaveOutBackground(scene, plan.counts);
     plan.optimalCoefficients.clear();
     if (config.optimalWeights)
       for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)

@@ -81,6 +81,7 @@ int runCompare(CompareArgs& args) {
     if (args.command->count("--size") == 0) args.scene.size = "64x64";
     Scene probe = args.scene.make();  // checks --size and --view
     for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
+      c.scene.shape = probe.options.shape;
       c.scene.viewTheta = probe.options.viewTheta;
       c.scene.viewPhi = probe.options.viewPhi;
       c.scene.product = probe.options.product;  // the suite with the product technique in every case
@@ -92,6 +93,10 @@ int runCompare(CompareArgs& args) {
     // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
+  // Nor per-pixel normals and views: the normal-independent compensated pdf stands in.
+  if (compare.cases.front().scene.perPixelGeometry() && args.command->count("--envmap-pdfs") == 0 &&
+      !compare.cases.front().scene.splitBrdf)
+    args.envmapPdfs = "plain,compensated";
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
   const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
@@ -183,7 +188,7 @@ Subcommand addCompareCommand(CLI::App& app) {
   command
       ->add_option("--envmap-pdfs", args->envmapPdfs,
                    "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal (default: plain and "
-                   "optimal side by side; plain alone with --split-brdf)")
+                   "optimal side by side; plain alone with --split-brdf; plain and compensated on spheres)")
       ->capture_default_str();
   command
       ->add_option("--weights", args->weights,

@@ -109,7 +109,7 @@ int runRender(RenderArgs& args) {
       outputs.addInput({"the cached reference (--cache-dir)", *cached});
   } else if (args.reference != "none") {
     reference = Reference{readExr(args.reference), {}, "file", args.reference};
-    checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}}, reference->image);
+    checkSameSize(RgbImage{scene.grid.width, scene.grid.height, {}, {}}, reference->image);
   }
   // A band renders its rows and those its pooling reads, with the image's random numbers.
   std::optional<Scene> bandRows;

@@ -9,6 +9,7 @@
 #include "MemoryBudget.h"
 #include "NumberList.h"
 #include "OptionRange.h"
+#include "scene/SceneShape.h"
 
 namespace misalloc {
 
@@ -20,8 +21,15 @@ void SceneArgs::add(CLI::App& command) {
       ->capture_default_str();
   command.add_option("--grid", options.grid, "seed000, general:RD0,RD1,N0,N1 or uniform:RD,RS,N")
       ->capture_default_str();
+  command
+      .add_option("--scene", options.shape,
+                  "plane ([HS14]'s: the grid over the image), sphere (the grid over one sphere) or "
+                  "spheres[:COLUMNSxROWS] (one BRDF of the grid per sphere, 4x4 by default)")
+      ->capture_default_str();
   command.add_option("--size", size, "WxH pixels")->capture_default_str();
-  command.add_option("--view", view, "view direction: polar angle THETA[,PHI] in degrees")->capture_default_str();
+  command.add_option("--view", view,
+                     "direction towards the camera: polar angle THETA[,PHI] in degrees (default 0 for the plane, "
+                     "75 for spheres)");
   command.add_flag("--split-brdf", options.splitBrdf,
                    "the BRDF's diffuse and specular lobes as separate techniques (M=3)");
   command.add_flag("--product", options.product,
@@ -33,30 +41,32 @@ void SceneArgs::add(CLI::App& command) {
 }
 
 void SceneArgs::addEnvmapPdf(CLI::App& command) {
-  envmapPdf = "optimal";
   envmapPdfOption = command.add_option(
       "--envmap-pdf", envmapPdf,
       "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C default 0.5) or "
       "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables); default optimal, plain with "
-      "--split-brdf or --method envmap");
+      "--split-brdf or --method envmap, compensated on spheres");
 }
 
-void SceneArgs::usePlainPdfByDefault() {
-  if (envmapPdfOption && envmapPdfOption->count() == 0) envmapPdf = "plain";
-}
+void SceneArgs::usePlainPdfByDefault() { plainPdfByDefault = true; }
 
 SceneOptions SceneArgs::parsed() {
   std::tie(options.width, options.height) = parseImageSize(size);
   const double pixels = double(options.width) * options.height;
   requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
                     pixels * kRenderBytesPerPixel);
+  const SceneShape shape = parseSceneShape(options.shape);
+  if (view.empty()) view = fmt::format("{}", defaultViewTheta(shape));
   std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");
   if (angles.size() > 2) throw InputError(fmt::format("--view {}: expected THETA[,PHI] in degrees", view));
   options.viewTheta = angles[0];
   options.viewPhi = angles.size() > 1 ? angles[1] : 0;
   options.sampler = parseEnvmapSampler(sampler);
   const bool defaultPdf = envmapPdfOption && envmapPdfOption->count() == 0;
-  options.envmapPdf = parseEnvmapPdf(defaultPdf && options.splitBrdf ? "plain" : envmapPdf);
+  if (!defaultPdf)
+    options.envmapPdf = parseEnvmapPdf(envmapPdf);
+  else
+    options.envmapPdf = plainPdfByDefault ? EnvmapPdf{} : defaultEnvmapPdf(options);
   return options;
 }
 

@@ -10,13 +10,13 @@ namespace misalloc {
 // sampler, and render's envmap pdf.
 struct SceneArgs {
   SceneOptions options;
-  std::string size = "128x128", view = "0", sampler = "alias", envmapPdf = "plain";
+  std::string size = "128x128", view, sampler = "alias", envmapPdf = "plain";
   CLI::Option* envmapPdfOption = nullptr;
+  bool plainPdfByDefault = false;
 
   void add(CLI::App& command);
-  // [Kar19]: render only; compare takes a list. Its default is the optimal pdf, the
-  // largest gain misalloc has, or the plain one where the optimal one cannot serve:
-  // with --split-brdf (not implemented) and for envmap sampling alone (usePlainPdfByDefault).
+  // [Kar19]: render only; compare takes a list. Its default is defaultEnvmapPdf's, or the
+  // plain one for envmap sampling alone (usePlainPdfByDefault).
   void addEnvmapPdf(CLI::App& command);
   void usePlainPdfByDefault();
 

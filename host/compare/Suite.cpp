@@ -9,6 +9,7 @@ std::string caseLabel(const SceneOptions& scene) {
   std::string name = scene.envmap;
   if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0)
     name = std::filesystem::path(name).stem().string();
+  if (scene.shape != "plane") name += "-" + scene.shape;
   for (char& ch : name)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
   if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";

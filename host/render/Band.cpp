@@ -19,7 +19,9 @@ std::vector<T> rowsOf(const std::vector<T>& values, size_t perRow, int firstRow,
 }
 
 RgbImage cropImage(const RgbImage& image, int firstRow, RowRange rows) {
-  return RgbImage{image.width, rows.size(), rowsOf(image.rgb, size_t(image.width) * 3, firstRow, rows)};
+  RgbImage out{image.width, rows.size(), rowsOf(image.rgb, size_t(image.width) * 3, firstRow, rows), {}};
+  if (!image.alpha.empty()) out.alpha = rowsOf(image.alpha, size_t(image.width), firstRow, rows);
+  return out;
 }
 
 }  // namespace
@@ -53,6 +55,7 @@ Scene bandScene(Scene image, RowRange rows) {
   image.grid.height = rows.size();
   image.grid.pixels = rowsOf(image.grid.pixels, width, 0, rows);
   image.geometry.pixels = rowsOf(image.geometry.pixels, width, 0, rows);
+  image.geometry.covered = rowsOf(image.geometry.covered, width, 0, rows);
   image.options.height = rows.size();
   if (image.tables.hasBank()) image.tables.brdfBinOfPixel = rowsOf(image.tables.brdfBinOfPixel, width, 0, rows);
   // Its tables now map the band's pixels only: never cached under the image's key.

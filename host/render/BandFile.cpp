@@ -103,7 +103,7 @@ MergedRender mergeBands(const std::vector<std::string>& paths) {
   for (const std::string& path : paths) bands.push_back(readBand(path));
   requireOneRun(bands);
   const BandRecord& first = bands.front().record;
-  MergedRender merged{RgbImage{first.width, first.height, {}}, {{"run", first.run}}};
+  MergedRender merged{RgbImage{first.width, first.height, {}, {}}, {{"run", first.run}}};
   nlohmann::json records = nlohmann::json::array();
   for (const ReadBand& b : bands) {
     merged.image.rgb.insert(merged.image.rgb.end(), b.rows.rgb.begin(), b.rows.rgb.end());
@@ -114,6 +114,13 @@ MergedRender mergeBands(const std::vector<std::string>& paths) {
                        {"node", b.record.node},
                        {"report", b.record.report}});
   }
+  // A band with no background pixel has no alpha of its own.
+  if (std::any_of(bands.begin(), bands.end(), [](const ReadBand& b) { return !b.rows.alpha.empty(); }))
+    for (const ReadBand& b : bands) {
+      const std::vector<float> opaque(size_t(b.rows.width) * b.rows.height, 1.0f);
+      const std::vector<float>& a = b.rows.alpha.empty() ? opaque : b.rows.alpha;
+      merged.image.alpha.insert(merged.image.alpha.end(), a.begin(), a.end());
+    }
   merged.report["size"] = {first.width, first.height};
   merged.report["bands"] = std::move(records);
   return merged;

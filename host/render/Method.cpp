@@ -108,7 +108,15 @@ StagePlan singleStagePlan(const Scene& scene, Method method, int spp) {
   plan.firstIndex.assign(size_t(pixels) * M, 0u);
   for (int pixel = 0; pixel < pixels; ++pixel)
     for (int n : methodCounts(scene, method, spp, pixel)) plan.counts.push_back(n);
+  leaveOutBackground(scene, plan.counts);
   return plan;
+}
+
+void leaveOutBackground(const Scene& scene, std::vector<int32_t>& counts) {
+  const int M = scene.techniqueCount();
+  const std::vector<unsigned char>& covered = scene.geometry.covered;
+  for (size_t p = 0; p < covered.size(); ++p)
+    if (!covered[p]) std::fill_n(counts.begin() + ptrdiff_t(p * M), M, 0);
 }
 
 }  // namespace misalloc

@@ -44,12 +44,12 @@ Scene referenceScene(const Scene& scene) {
   SceneOptions options = scene.options;
   // The same reference with or without the product technique, which changes the noise only.
   options.product = false;
-  options.envmapPdf = options.splitBrdf ? EnvmapPdf{} : parseEnvmapPdf("optimal");
+  options.envmapPdf = defaultEnvmapPdf(options);
   return makeScene(options);
 }
 
 std::string referenceEstimator(const SceneOptions& scene) {
-  return fmt::format("equal-count MIS, {} envmap pdf", scene.splitBrdf ? "plain" : "optimal");
+  return fmt::format("equal-count MIS, {} envmap pdf", envmapPdfName(defaultEnvmapPdf(scene)));
 }
 
 SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int spp, uint64_t seed,
@@ -83,8 +83,9 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
   // The batches are independent unbiased estimates; weighting each by its share of the
   // samples gives every sample the same weight. With σ² a sample's variance,
   // Σ_b n_b (x_b − x̄)² / (B − 1) estimates σ², and the mean's variance is σ²/N.
-  SampledReference out{RgbImage{scene.grid.width, scene.grid.height, std::vector<float>(sum.size())},
-                       std::vector<float>(sum.size())};
+  SampledReference out{
+      RgbImage{scene.grid.width, scene.grid.height, std::vector<float>(sum.size()), scene.geometry.alpha()},
+      std::vector<float>(sum.size())};
   for (size_t i = 0; i < sum.size(); ++i) {
     const double mean = sum[i] / spp;
     out.image.rgb[i] = float(mean);
@@ -108,8 +109,14 @@ std::string referenceKey(const Scene& scene, int spp) {
   h.addValue(scene.grid.height);
   h.addValue(scene.options.viewTheta);
   h.addValue(scene.options.viewPhi);
-  // Per-pixel frames: every one of them (a flat scene's are the view above).
-  if (!scene.geometry.flat()) h.add(scene.geometry.pixels.data(), scene.geometry.pixels.size() * sizeof(PixelFrame));
+  // Per-pixel frames, BRDFs and coverage: every one of them (a flat scene's are the view
+  // and the grid above).
+  if (!scene.geometry.flat() || scene.geometry.hasBackground()) {
+    const SceneGeometry& g = scene.geometry;
+    h.add(g.pixels.data(), g.pixels.size() * sizeof(PixelFrame));
+    h.add(g.covered.data(), g.covered.size());
+    h.add(scene.grid.pixels.data(), scene.grid.pixels.size() * sizeof(PhongParameters));
+  }
   h.addValue(spp);
   h.add(referenceEstimator(scene.options));
   return fmt::format("{:016x}", h.h);

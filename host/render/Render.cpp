@@ -99,6 +99,7 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
   stage.plan.stageSamples = stageSamples;
   stage.plan.samplesBefore = progress.samplesBefore;
   stage.plan.keepStatistics = keepStatistics;
+  leaveOutBackground(sampler.scene(), counts);
   stage.plan.counts = std::move(counts);
   stage.plan.firstIndex.assign(progress.taken.begin(), progress.taken.end());
   StageTiming timing;
@@ -330,12 +331,17 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     }
     out.meanPilotWeight = std::accumulate(pilotWeights.begin(), pilotWeights.end(), 0.0) / pixels;
   }
+  // The background's sums are empty: whatever the rules made of them is not reported.
+  const std::vector<unsigned char>& covered = scene.geometry.covered;
+  for (auto* flags : {&progress.fellBack, &progress.floored, &progress.skipped, &progress.weightsFallback})
+    for (int p = 0; p < pixels; ++p) (*flags)[p] &= covered[p] ? 0xff : 0;
   out.fallbackPixels = size_t(std::count(progress.fellBack.begin(), progress.fellBack.end(), 1));
   out.flooredPixels = size_t(std::count(progress.floored.begin(), progress.floored.end(), 1));
   out.skippedPixels = size_t(std::count(progress.skipped.begin(), progress.skipped.end(), 1));
   out.weightsFallbacks = countWeightsFallbacks(progress.weightsFallback);
-  out.image = RgbImage{scene.grid.width, scene.grid.height,
-                       std::vector<float>(progress.totals.rgb.begin(), progress.totals.rgb.end())};
+  out.image =
+      RgbImage{scene.grid.width, scene.grid.height,
+               std::vector<float>(progress.totals.rgb.begin(), progress.totals.rgb.end()), scene.geometry.alpha()};
   out.variance = std::move(progress.totals.variance);
   out.alpha.resize(progress.taken.size());
   for (size_t i = 0; i < progress.taken.size(); ++i) out.alpha[i] = double(progress.taken[i]) / spp;

@@ -19,17 +19,19 @@ double rmse(const RgbImage& image, const RgbImage& reference) {
   checkSameSize(image, reference);
   double sum = 0;
   for (size_t i = 0; i < image.rgb.size(); ++i) {
+    if (!image.covers(i / 3)) continue;
     double d = double(image.rgb[i]) - reference.rgb[i];
     sum += d * d;
   }
-  return std::sqrt(sum / double(image.rgb.size()));
+  return std::sqrt(sum / double(3 * image.coveredPixels()));
 }
 
 CorrectedMse correctedMse(const RgbImage& image, const RgbImage& reference, const std::vector<float>& referenceError) {
   checkSameSize(image, reference);
-  const size_t pixels = image.rgb.size() / 3;
+  const size_t pixels = image.coveredPixels();
   double sum = 0, sumSquares = 0;
-  for (size_t p = 0; p < pixels; ++p) {
+  for (size_t p = 0; p < image.rgb.size() / 3; ++p) {
+    if (!image.covers(p)) continue;
     double term = 0;
     for (size_t i = 3 * p; i < 3 * p + 3; ++i) {
       const double d = double(image.rgb[i]) - reference.rgb[i];
@@ -50,10 +52,11 @@ double relativeMse(const RgbImage& image, const RgbImage& reference) {
   constexpr double epsilon = 0.01;
   double sum = 0;
   for (size_t i = 0; i < image.rgb.size(); ++i) {
+    if (!image.covers(i / 3)) continue;
     double r = reference.rgb[i], d = double(image.rgb[i]) - r;
     sum += d * d / (r * r + epsilon);
   }
-  return sum / double(image.rgb.size());
+  return sum / double(3 * image.coveredPixels());
 }
 
 }  // namespace misalloc

@@ -3,6 +3,9 @@
 
 namespace misalloc {
 
+// Every error is over the pixels that `image` covers (RgbImage::alpha): the background
+// takes no samples and counts in no error.
+
 // Root mean squared error over all pixels and RGB channels ([HS14] Table 5.2 reports
 // it ×1000).
 double rmse(const RgbImage& image, const RgbImage& reference);

@@ -103,7 +103,9 @@ nlohmann::json sceneJson(const Scene& scene) {
                          {"envmap_uniform_fallback", scene.tables.uniformFallback},
                          {"envmap_negative_values_zeroed", scene.envmapWarnings.negativeValues},
                          {"grid", o.grid},
+                         {"shape", o.shape},
                          {"size", {o.width, o.height}},
+                         {"covered_pixels", scene.geometry.coveredPixels()},
                          {"view_deg", {o.viewTheta, o.viewPhi}},
                          {"techniques", scene.techniqueNames()},
                          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
@@ -153,7 +155,9 @@ nlohmann::json costModelJson(const CostModel& model, const std::vector<std::stri
 
 nlohmann::json renderReport(const RenderRun& run) {
   const Rendering& r = run.rendering;
-  const int pixels = run.scene.pixelCount(), M = run.scene.techniqueCount();
+  // Over the covered pixels: the background's variance is 0, its samples none.
+  const double pixels = double(r.image.coveredPixels());
+  const int M = run.scene.techniqueCount();
   double meanVariance = 0;
   for (double v : r.variance) meanVariance += v;
   meanVariance /= pixels;
@@ -170,7 +174,7 @@ nlohmann::json renderReport(const RenderRun& run) {
       {"seed", run.seed},
       {"device", run.device},
       {"time_s", timeSplitJson(r.wallSeconds, r.kernelSeconds, r.allocationSeconds, r.hostSeconds)},
-      {"samples_per_second", double(pixels) * run.spp / r.kernelSeconds},
+      {"samples_per_second", pixels * run.spp / r.kernelSeconds},
       {"estimated_rmse_luminance_x1000", 1000 * std::sqrt(meanVariance)},
       {"mean_alpha", meanAlpha},
       {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},

@@ -107,7 +107,7 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + kern::statsOffset(pixel, slots);
-    for (int j = 0; j < plan.stageSamples; ++j) {
+    for (int j = 0; j < kern::pixelStageSamples(c); ++j) {
       kern::SampleContribution s = kern::takeStageSample(pixelTs, pixelEnv, sp, c, j, uint32_t(seed),
                                                          uint32_t(seed >> 32), uint32_t(scene_.firstPixel + pixel));
       if (config_.optimalWeights) s = kern::withOptimalWeights(s, c, a);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 
 #include "Error.h"
 #include "NumberList.h"
@@ -28,9 +29,11 @@ void checkParameters(const std::string& spec, double rhoD, double rhoS, double n
 
 float seed000Exponent(float x) { return float(-1.0 - 0.111211 / (0.1 * std::pow(double(x), 0.2) - 0.101101)); }
 
-BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height) {
+BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height, const std::vector<SurfaceUv>& uv) {
   if (width <= 0 || height <= 0)
     throw InputError(fmt::format("--size {}x{}: both sides must be positive", width, height));
+  if (uv.size() != size_t(width) * size_t(height))
+    throw std::invalid_argument(fmt::format("{} surface points for a {}x{} grid", uv.size(), width, height));
   auto colon = spec.find(':');
   std::string kind = spec.substr(0, colon);
   std::string args = colon == std::string::npos ? "" : spec.substr(colon + 1);
@@ -58,10 +61,22 @@ BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height) {
     throw InputError(fmt::format("unknown --grid '{}' (expected {})", spec, kForms));
   }
   BrdfGrid grid{spec, width, height, {}};
-  grid.pixels.reserve(size_t(width) * height);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) grid.pixels.push_back(at((x + 0.5) / width, (y + 0.5) / height));
+  grid.pixels.reserve(uv.size());
+  for (const SurfaceUv& p : uv) grid.pixels.push_back(at(p.u, p.v));
   return grid;
+}
+
+BrdfGrid makeBrdfGrid(const std::string& spec, int width, int height) {
+  return makeBrdfGrid(spec, width, height, pixelCentres(width, height));
+}
+
+std::vector<SurfaceUv> pixelCentres(int width, int height) {
+  std::vector<SurfaceUv> uv;
+  if (width <= 0 || height <= 0) return uv;
+  uv.reserve(size_t(width) * height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) uv.push_back({(x + 0.5) / width, (y + 0.5) / height});
+  return uv;
 }
 
 }  // namespace misalloc

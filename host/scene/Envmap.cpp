@@ -65,7 +65,7 @@ double cosThetaOfSubrow(int row, int s, int n, int height) {
 template <class RadianceOfCosTheta>
 RgbImage rasteriseRows(int width, int height, RadianceOfCosTheta radiance) {
   constexpr int kSubrows = 16;
-  RgbImage image{width, height, std::vector<float>(std::size_t(width) * std::size_t(height) * 3)};
+  RgbImage image{width, height, std::vector<float>(std::size_t(width) * std::size_t(height) * 3), {}};
   for (int row = 0; row < height; ++row) {
     Rgb sum{0, 0, 0};
     for (int s = 0; s < kSubrows; ++s) {
@@ -258,6 +258,7 @@ Envmap makeEnvmap(const std::string& spec, int proceduralWidth, ReadWarnings* wa
     std::error_code ignored;
     if (!std::filesystem::exists(spec, ignored)) throw badSpec(spec, "no such file");
     map.image = readExr(spec, warnings);
+    map.image.alpha = {};  // a map is seen whole: its alpha is no coverage of ours
     map.description = spec;
   }
   refuseOverflowingRadiance(map.image, spec);

@@ -75,16 +75,20 @@ RgbImage blankImage(const Imath::Box2i& window, const std::string& path) {
   return image;
 }
 
-// The data window's texels that lie in the display window, at their place in it.
+// The data window's texels that lie in the display window, at their place in it; the
+// rest transparent black where the image has coverage.
 RgbImage placeInDisplayWindow(const RgbImage& data, const Imath::Box2i& dataWindow, const Imath::Box2i& display,
                               const std::string& path) {
   RgbImage image = blankImage(display, path);
+  if (!data.alpha.empty()) image.alpha.assign(std::size_t(image.width) * std::size_t(image.height), 0.0f);
   const int x0 = std::max(dataWindow.min.x, display.min.x), x1 = std::min(dataWindow.max.x, display.max.x);
   for (int y = std::max(dataWindow.min.y, display.min.y); y <= std::min(dataWindow.max.y, display.max.y); ++y)
-    for (int x = x0; x <= x1; ++x)
-      for (int c = 0; c < 3; ++c)
-        image.rgb[3 * (std::size_t(y - display.min.y) * image.width + std::size_t(x - display.min.x)) + c] =
-            data.rgb[3 * (std::size_t(y - dataWindow.min.y) * data.width + std::size_t(x - dataWindow.min.x)) + c];
+    for (int x = x0; x <= x1; ++x) {
+      const std::size_t to = std::size_t(y - display.min.y) * image.width + std::size_t(x - display.min.x);
+      const std::size_t from = std::size_t(y - dataWindow.min.y) * data.width + std::size_t(x - dataWindow.min.x);
+      for (int c = 0; c < 3; ++c) image.rgb[3 * to + c] = data.rgb[3 * from + c];
+      if (!data.alpha.empty()) image.alpha[to] = data.alpha[from];
+    }
   return image;
 }
 
@@ -105,6 +109,11 @@ RgbImage readRgbPixels(const std::string& path, ExrAttributes* attributes) {
   for (int c = 0; c < 3; ++c)
     frame.insert(std::string(1, kRgbNames[c]), Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window, pixelBytes,
                                                                 pixelBytes * std::size_t(image.width)));
+  if (header.channels().findChannel("A")) {
+    image.alpha.assign(std::size_t(image.width) * std::size_t(image.height), 0.0f);
+    frame.insert("A", Imf::Slice::Make(Imf::FLOAT, image.alpha.data(), window, sizeof(float),
+                                       sizeof(float) * std::size_t(image.width)));
+  }
   file.setFrameBuffer(frame);
   file.readPixels(window.min.y, window.max.y);
   if (attributes)
@@ -121,6 +130,10 @@ void rejectNonFinite(const RgbImage& image, const std::string& path) {
   if (count > 0)
     throw InputError(fmt::format("'{}' has {} NaN or infinite channel values, the first at {}", path, count,
                                  toString(locationOf(first, image.width))));
+  for (std::size_t p = 0; p < image.alpha.size(); ++p)
+    if (!(image.alpha[p] >= 0 && image.alpha[p] <= 1))
+      throw InputError(fmt::format("'{}': its alpha at x={}, y={} is {}, not in [0, 1]", path,
+                                   p % std::size_t(image.width), p / std::size_t(image.width), image.alpha[p]));
 }
 
 void zeroNegatives(RgbImage& image, ReadWarnings* warnings) {
@@ -182,6 +195,11 @@ Imf::Header floatHeader(int width, int height, const std::vector<std::string>& n
 
 }  // namespace
 
+std::size_t RgbImage::coveredPixels() const {
+  if (alpha.empty()) return std::size_t(width) * std::size_t(height);
+  return std::size_t(std::count_if(alpha.begin(), alpha.end(), [](float a) { return a > 0; }));
+}
+
 std::string toString(const TexelLocation& location) {
   return fmt::format("x={}, y={}, channel {}", location.x, location.y, location.channel);
 }
@@ -205,13 +223,22 @@ std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes) {
   if (image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
     throw std::invalid_argument(
         fmt::format("RgbImage {}×{} holds {} floats, not 3 per pixel", image.width, image.height, image.rgb.size()));
-  Imf::Header header = floatHeader(image.width, image.height, {"R", "G", "B"});
+  const bool coverage = !image.alpha.empty();
+  if (coverage && image.alpha.size() != std::size_t(image.width) * std::size_t(image.height))
+    throw std::invalid_argument(
+        fmt::format("RgbImage {}×{} holds {} alpha values", image.width, image.height, image.alpha.size()));
+  Imf::Header header =
+      floatHeader(image.width, image.height,
+                  coverage ? std::vector<std::string>{"R", "G", "B", "A"} : std::vector<std::string>{"R", "G", "B"});
   for (const auto& [name, value] : attributes) header.insert(name, Imf::StringAttribute(value));
   const std::size_t pixelBytes = 3 * sizeof(float);
   Imf::FrameBuffer frame;
   for (int c = 0; c < 3; ++c)
     frame.insert(std::string(1, kRgbNames[c]), Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, header.dataWindow(),
                                                                 pixelBytes, pixelBytes * std::size_t(image.width)));
+  if (coverage)
+    frame.insert("A", Imf::Slice::Make(Imf::FLOAT, image.alpha.data(), header.dataWindow(), sizeof(float),
+                                       sizeof(float) * std::size_t(image.width)));
   requireFinite(image.rgb.data(), image.rgb.size(), fmt::format("the {}×{} image", image.width, image.height));
   return encode(header, frame);
 }
@@ -254,8 +281,8 @@ std::vector<std::vector<float>> readExrChannels(const std::string& path, const s
       if (!file.header().channels().findChannel(names[k]))
         throw InputError(fmt::format("'{}' has no channel {} (channels found: {})", path, names[k],
                                      channelNames(file.header().channels())));
-      frame.insert(names[k], Imf::Slice::Make(Imf::FLOAT, planes[k].data(), window, sizeof(float),
-                                              sizeof(float) * width));
+      frame.insert(names[k],
+                   Imf::Slice::Make(Imf::FLOAT, planes[k].data(), window, sizeof(float), sizeof(float) * width));
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);

@@ -7,10 +7,16 @@
 
 namespace misalloc {
 
-// Linear RGB radiance, 3 floats per pixel, row-major, row 0 (the top) first.
+// Linear RGB radiance, 3 floats per pixel, row-major, row 0 (the top) first; with
+// coverage, an alpha per pixel: 1 where a surface is seen, 0 for the background, whose
+// RGB is 0 (transparent black). Without it every pixel is covered.
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<float> rgb;
+  std::vector<float> alpha;  // empty, or one value per pixel (the EXR's A channel)
+
+  bool covers(std::size_t pixel) const { return alpha.empty() || alpha[pixel] > 0; }
+  std::size_t coveredPixels() const;
 };
 
 // One channel value of an image: column x, row y (0 = top), channel 'R', 'G' or 'B'.
@@ -33,7 +39,7 @@ struct ReadWarnings {
 using ExrAttributes = std::map<std::string, std::string>;
 
 // Reads the R, G and B channels of `path` as float, whatever their stored type
-// (half, float or uint); an alpha or any other channel is ignored. The image is the
+// (half, float or uint), and its A channel where it has one; any other channel is ignored. The image is the
 // display window, the rectangle the file's pixels stand for (for an envmap, the whole
 // sphere): its texels outside the data window are black, and data outside it is
 // left out. Throws InputError, naming the file, if it is missing, not an OpenEXR file,
@@ -41,7 +47,7 @@ using ExrAttributes = std::map<std::string, std::string>;
 // values. `attributes`, if given, receives the header's string attributes.
 RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr, ExrAttributes* attributes = nullptr);
 
-// The bytes of an OpenEXR file of float R, G, B with ZIP compression, with `attributes`
+// The bytes of an OpenEXR file of float R, G, B (and A with coverage) with ZIP compression, with `attributes`
 // in its header. Both encoders refuse (std::runtime_error) values that are NaN or
 // infinite: a written image is always finite.
 std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes = {});

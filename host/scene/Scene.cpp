@@ -11,9 +11,17 @@
 #include "Error.h"
 #include "KernelCode.h"
 #include "distributions/BankCache.h"
+#include "scene/SceneShape.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
+
+bool SceneOptions::perPixelGeometry() const { return parseSceneShape(shape).kind != SceneShape::Plane; }
+
+EnvmapPdf defaultEnvmapPdf(const SceneOptions& options) {
+  if (options.splitBrdf) return {};
+  return parseEnvmapPdf(options.perPixelGeometry() ? "compensated" : "optimal");
+}
 
 int SceneOptions::techniqueRole(int technique) const { return kern::techniqueRole(splitBrdf, product, technique); }
 
@@ -87,8 +95,10 @@ Scene makeScene(const SceneOptions& options) {
         "and the BRDF's lobes split and the product make 4");
   Scene scene;
   scene.options = options;
-  scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
-  scene.geometry = planeGeometry(scene.pixelCount(), options.viewTheta, options.viewPhi);
+  ShapeImage shape =
+      shapeImage(parseSceneShape(options.shape), options.width, options.height, options.viewTheta, options.viewPhi);
+  scene.grid = makeBrdfGrid(options.grid, options.width, options.height, shape.uv);
+  scene.geometry = std::move(shape.geometry);
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);

@@ -14,8 +14,9 @@ namespace misalloc {
 struct SceneOptions {
   std::string envmap = "forest_slope";  // a path, a shipped map's name, or a procedural spec
   std::string grid = "seed000";
+  std::string shape = "plane";  // --scene (scene/SceneShape.h)
   int width = 128, height = 128;
-  double viewTheta = 0, viewPhi = 0;  // the plane's ω_o in degrees (planeGeometry)
+  double viewTheta = 0, viewPhi = 0;  // ω_o in degrees (shapeImage)
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
   bool product = false;               // M = 3: envmap × BRDF × cos as a third technique (--product)
   EnvmapSampler sampler = EnvmapSampler::Alias;
@@ -28,6 +29,10 @@ struct SceneOptions {
   // M: envmap sampling and BRDF sampling, then either of the BRDF's lobes split, or the
   // product technique.
   int techniqueCount() const { return splitBrdf || product ? 3 : 2; }
+  // Whether each pixel has a normal and view of its own (not [HS14]'s plane), for which
+  // the optimal pdf and the product technique are not implemented.
+  bool perPixelGeometry() const;
+
   // What technique k samples: kern::ROLE_ENVMAP, ROLE_BRDF, ... (kernels/estimator.h).
   int techniqueRole(int technique) const;
 };
@@ -68,6 +73,11 @@ Scene makeScene(const SceneOptions& options);
 // Writes the optimal pdf's tables to the cache where makeScene built them: after a run
 // has done its work, so that a refused or failed run writes no cache entry.
 void cacheOptimalBank(const Scene& scene);
+
+// The envmap pdf of a render that names none: the optimal one ([Kar19] eq. 9), the
+// largest gain misalloc has, where it can serve; with the BRDF's lobes split the plain
+// one; with per-pixel geometry the compensated one ([Kar19] eq. 14), normal-independent.
+EnvmapPdf defaultEnvmapPdf(const SceneOptions& options);
 
 // The scene with the plain envmap pdf, for the reference: the pdf changes the noise,
 // not the integral, and a reference computed once must not depend on which pdf asked

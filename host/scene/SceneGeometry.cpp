@@ -15,6 +15,15 @@ bool SceneGeometry::flat() const {
                      [&](const PixelFrame& f) { return f.normal == up && f.mirror == pixels.front().mirror; });
 }
 
+bool SceneGeometry::hasBackground() const { return coveredPixels() < covered.size(); }
+
+std::size_t SceneGeometry::coveredPixels() const { return std::size_t(std::count(covered.begin(), covered.end(), 1)); }
+
+std::vector<float> SceneGeometry::alpha() const {
+  if (!hasBackground()) return {};
+  return std::vector<float>(covered.begin(), covered.end());
+}
+
 Vec3f mirrorDirection(const Vec3f& n, const Vec3f& v) {
   const double d = 2.0 * (double(n[0]) * v[0] + double(n[1]) * v[1] + double(n[2]) * v[2]);
   return {float(d * n[0] - v[0]), float(d * n[1] - v[1]), float(d * n[2] - v[2])};
@@ -28,6 +37,7 @@ SceneGeometry planeGeometry(int pixels, double viewThetaDegrees, double viewPhiD
   const Vec3f view{float(std::sin(t) * std::cos(p)), float(std::sin(t) * std::sin(p)), float(std::cos(t))};
   SceneGeometry g;
   g.pixels.assign(size_t(pixels), PixelFrame{up, mirrorDirection(up, view)});
+  g.covered.assign(size_t(pixels), 1);
   return g;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <array>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,14 @@ struct PixelFrame {
 // BRDF grid.
 struct SceneGeometry {
   std::vector<PixelFrame> pixels;  // row-major as the BRDF grid, row 0 at the top
+  // Per pixel: 1 where a surface is seen, 0 for the background, which takes no samples
+  // and counts in no error (its frame is z, never sampled).
+  std::vector<unsigned char> covered;
+
+  bool hasBackground() const;
+  std::size_t coveredPixels() const;
+  // The image's alpha (RgbImage::alpha): none without background, else 1 or 0 per pixel.
+  std::vector<float> alpha() const;
 
   // [HS14] Sec. 5.2's scene: every pixel's normal is z and its view the same. The
   // optimal pdf's bank and the product tables are built for that one frame.
