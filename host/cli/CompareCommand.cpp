@@ -82,6 +82,7 @@ int runCompare(CompareArgs& args) {
     Scene probe = args.scene.make();  // checks --size and --view
     for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
       c.scene.shape = probe.options.shape;
+      c.scene.gbuffer = probe.options.gbuffer;
       c.scene.viewTheta = probe.options.viewTheta;
       c.scene.viewPhi = probe.options.viewPhi;
       c.scene.product = probe.options.product;  // the suite with the product technique in every case

@@ -14,6 +14,7 @@
 namespace misalloc {
 
 void SceneArgs::add(CLI::App& command) {
+  app = &command;
   command
       .add_option("--envmap", options.envmap,
                   "EXR path, shipped map name (forest_slope, rooitou_park, ...), constant[:R], cosk:K or "
@@ -26,6 +27,21 @@ void SceneArgs::add(CLI::App& command) {
                   "plane ([HS14]'s: the grid over the image), sphere (the grid over one sphere) or "
                   "spheres[:COLUMNSxROWS] (one BRDF of the grid per sphere, 4x4 by default)")
       ->capture_default_str();
+  command.add_option("--gbuffer", options.gbuffer.path,
+                     "an EXR G-buffer (shading normals, positions, alpha) instead of --scene; its size is the image's");
+  command
+      .add_option("--convention", options.gbuffer.convention,
+                  "whose G-buffer and lat-long map: misalloc, mitsuba, blender or pbrt (their world frames and map "
+                  "orientations)")
+      ->capture_default_str();
+  command.add_option("--normal-channels", options.gbuffer.normalChannels,
+                     "the G-buffer's normal channels' prefix (PREFIX.X/Y/Z), if not the convention's");
+  command.add_option("--position-channels", options.gbuffer.positionChannels,
+                     "the G-buffer's position channels' prefix (PREFIX.X/Y/Z), if not the convention's");
+  command.add_option("--camera-origin", options.gbuffer.cameraOrigin,
+                     "X,Y,Z: the camera's position in the G-buffer's world (pbrt: from its header)");
+  command.add_option("--gbuffer-space", options.gbuffer.space,
+                     "camera or world: pbrt-v4's G-buffer space (default camera, pbrt's own default)");
   command.add_option("--size", size, "WxH pixels")->capture_default_str();
   command.add_option("--view", view,
                      "direction towards the camera: polar angle THETA[,PHI] in degrees (default 0 for the plane, "
@@ -55,6 +71,10 @@ SceneOptions SceneArgs::parsed() {
   const double pixels = double(options.width) * options.height;
   requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
                     pixels * kRenderBytesPerPixel);
+  if (!options.gbuffer.path.empty())
+    for (const char* option : {"--size", "--view", "--scene"})
+      if (app && app->count(option) > 0)
+        throw InputError(fmt::format("--gbuffer with {}: the G-buffer sets the image and each pixel's view", option));
   const SceneShape shape = parseSceneShape(options.shape);
   if (view.empty()) view = fmt::format("{}", defaultViewTheta(shape));
   std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");

@@ -12,6 +12,7 @@ struct SceneArgs {
   SceneOptions options;
   std::string size = "128x128", view, sampler = "alias", envmapPdf = "plain";
   CLI::Option* envmapPdfOption = nullptr;
+  const CLI::App* app = nullptr;  // the command the options were added to
   bool plainPdfByDefault = false;
 
   void add(CLI::App& command);

@@ -10,6 +10,7 @@ std::string caseLabel(const SceneOptions& scene) {
   if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0)
     name = std::filesystem::path(name).stem().string();
   if (scene.shape != "plane") name += "-" + scene.shape;
+  if (!scene.gbuffer.path.empty()) name += "-" + std::filesystem::path(scene.gbuffer.path).stem().string();
   for (char& ch : name)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
   if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";

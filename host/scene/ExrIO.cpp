@@ -5,6 +5,7 @@
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
+#include <ImfMatrixAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 #include <ImfTestFile.h>
@@ -267,6 +268,26 @@ std::string encodeExrChannels(int width, int height, const std::vector<std::stri
 void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,
                       const std::vector<std::vector<float>>& planes) {
   writeFileAtomically(path, encodeExrChannels(width, height, names, planes));
+}
+
+ExrHeader readExrHeader(const std::string& path) {
+  requireOpenExrFile(path);
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imf::Header& header = file.header();
+    ExrHeader out;
+    out.width = widthOf(header.dataWindow());
+    out.height = heightOf(header.dataWindow());
+    for (auto c = header.channels().begin(); c != header.channels().end(); ++c) out.channels.push_back(c.name());
+    for (auto a = header.begin(); a != header.end(); ++a)
+      if (const auto* m = dynamic_cast<const Imf::M44fAttribute*>(&a.attribute())) {
+        std::array<float, 16>& values = out.matrices[a.name()];
+        for (int i = 0; i < 16; ++i) values[size_t(i)] = m->value()[i / 4][i % 4];
+      }
+    return out;
+  } catch (const std::exception& e) {
+    throw InputError(fmt::format("cannot read '{}' (truncated or corrupt?): {}", path, e.what()));
+  }
 }
 
 std::vector<std::vector<float>> readExrChannels(const std::string& path, const std::vector<std::string>& names) {

@@ -1,5 +1,6 @@
 #pragma once
 // Reading and writing scanline OpenEXR images as 32-bit float channels.
+#include <array>
 #include <cstddef>
 #include <map>
 #include <string>
@@ -64,6 +65,17 @@ std::string encodeExrChannels(int width, int height, const std::vector<std::stri
 // The channels `names` of a file encodeExrChannels wrote, one plane each over its data
 // window. Throws InputError naming the file if it cannot be read or lacks a channel.
 std::vector<std::vector<float>> readExrChannels(const std::string& path, const std::vector<std::string>& names);
+
+// What the header of `path` says: its data window's size, its channels' names, and its
+// 4×4 float matrix attributes by name, their 16 values in the order stored (pbrt-v4
+// stores its matrices row by row, for column vectors: p' = M p). Throws InputError
+// naming the file if it cannot be read.
+struct ExrHeader {
+  int width = 0, height = 0;
+  std::vector<std::string> channels;
+  std::map<std::string, std::array<float, 16>> matrices;
+};
+ExrHeader readExrHeader(const std::string& path);
 
 // Writes encodeExrChannels's bytes through writeFileAtomically.
 void writeExrChannels(const std::string& path, int width, int height, const std::vector<std::string>& names,

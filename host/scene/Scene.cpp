@@ -16,7 +16,9 @@
 namespace misalloc {
 namespace fs = std::filesystem;
 
-bool SceneOptions::perPixelGeometry() const { return parseSceneShape(shape).kind != SceneShape::Plane; }
+bool SceneOptions::perPixelGeometry() const {
+  return !gbuffer.path.empty() || parseSceneShape(shape).kind != SceneShape::Plane;
+}
 
 EnvmapPdf defaultEnvmapPdf(const SceneOptions& options) {
   if (options.splitBrdf) return {};
@@ -95,10 +97,19 @@ Scene makeScene(const SceneOptions& options) {
         "and the BRDF's lobes split and the product make 4");
   Scene scene;
   scene.options = options;
-  ShapeImage shape =
-      shapeImage(parseSceneShape(options.shape), options.width, options.height, options.viewTheta, options.viewPhi);
-  scene.grid = makeBrdfGrid(options.grid, options.width, options.height, shape.uv);
-  scene.geometry = std::move(shape.geometry);
+  if (!options.gbuffer.path.empty()) {
+    if (options.shape != "plane") throw InputError("--gbuffer with --scene: the G-buffer is the scene; drop one");
+    GBufferImage gbuffer = readGBuffer(options.gbuffer);
+    scene.options.width = gbuffer.width;
+    scene.options.height = gbuffer.height;
+    scene.grid = makeBrdfGrid(options.grid, gbuffer.width, gbuffer.height);
+    scene.geometry = std::move(gbuffer.geometry);
+  } else {
+    ShapeImage shape =
+        shapeImage(parseSceneShape(options.shape), options.width, options.height, options.viewTheta, options.viewPhi);
+    scene.grid = makeBrdfGrid(options.grid, options.width, options.height, shape.uv);
+    scene.geometry = std::move(shape.geometry);
+  }
   std::string resolved = resolveEnvmapSpec(options.envmap);
   if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
   scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);

@@ -7,6 +7,7 @@
 #include "distributions/ProductTables.h"
 #include "scene/BrdfGrid.h"
 #include "scene/Envmap.h"
+#include "scene/GBuffer.h"
 #include "scene/SceneGeometry.h"
 
 namespace misalloc {
@@ -15,6 +16,7 @@ struct SceneOptions {
   std::string envmap = "forest_slope";  // a path, a shipped map's name, or a procedural spec
   std::string grid = "seed000";
   std::string shape = "plane";  // --scene (scene/SceneShape.h)
+  GBufferOptions gbuffer;       // --gbuffer: each pixel's frame read from a file instead of a shape
   int width = 128, height = 128;
   double viewTheta = 0, viewPhi = 0;  // ω_o in degrees (shapeImage)
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own

@@ -1,0 +1,206 @@
+#include "scene/GBuffer.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "Error.h"
+#include "NumberList.h"
+#include "scene/ExrIO.h"
+
+namespace misalloc {
+namespace {
+
+using Vec = Eigen::Vector3d;
+
+struct ChannelPrefixes {
+  std::string normal, position;
+};
+
+// Blender names its passes by view layer: the one layer whose Normal pass the file holds.
+std::string blenderViewLayer(const ExrHeader& header, const std::string& path) {
+  std::vector<std::string> layers;
+  const std::string suffix = ".Normal.X";
+  for (const std::string& c : header.channels)
+    if (c.size() > suffix.size() && c.compare(c.size() - suffix.size(), suffix.size(), suffix) == 0)
+      layers.push_back(c.substr(0, c.size() - suffix.size()));
+  if (layers.empty())
+    throw InputError(fmt::format("'{}' has no <ViewLayer>.Normal.X channel, Blender's Normal pass (channels found: {})",
+                                 path, fmt::join(header.channels, ", ")));
+  if (layers.size() > 1)
+    throw InputError(
+        fmt::format("'{}' holds the Normal passes of several view layers ({}): name one with "
+                    "--normal-channels and --position-channels",
+                    path, fmt::join(layers, ", ")));
+  return layers.front();
+}
+
+ChannelPrefixes channelPrefixes(GBufferConvention convention, const GBufferOptions& options, const ExrHeader& header) {
+  ChannelPrefixes p;
+  switch (convention) {
+    case GBufferConvention::Misalloc:
+      p = {"N", "P"};
+      break;
+    case GBufferConvention::Mitsuba:
+      p = {"sh_normal", "position"};
+      break;
+    case GBufferConvention::Pbrt:
+      p = {"Ns", "P"};
+      break;
+    case GBufferConvention::Blender:
+      if (options.normalChannels.empty() || options.positionChannels.empty()) {
+        const std::string layer = blenderViewLayer(header, options.path);
+        p = {layer + ".Normal", layer + ".Position"};
+      }
+      break;
+  }
+  if (!options.normalChannels.empty()) p.normal = options.normalChannels;
+  if (!options.positionChannels.empty()) p.position = options.positionChannels;
+  return p;
+}
+
+// The channels a prefix names, or why the file lacks them.
+std::vector<std::string> xyz(const std::string& prefix) { return {prefix + ".X", prefix + ".Y", prefix + ".Z"}; }
+
+void requireChannels(const ExrHeader& header, const std::vector<std::string>& names, const std::string& path,
+                     const std::string& option) {
+  for (const std::string& n : names)
+    if (std::find(header.channels.begin(), header.channels.end(), n) == header.channels.end())
+      throw InputError(fmt::format("'{}' has no channel {} (looked for {}; name others with {}; channels found: {})",
+                                   path, n, fmt::join(names, ", "), option, fmt::join(header.channels, ", ")));
+}
+
+// The frames' way into the convention's world: camera space through the header's matrix.
+struct WorldFromFile {
+  std::optional<Eigen::Matrix4d> cameraFromWorld;  // camera space; none: world space
+  std::optional<Vec> cameraOrigin;                 // world space: where each pixel is seen from
+};
+
+WorldFromFile worldFromFile(GBufferConvention convention, const GBufferOptions& options, const ExrHeader& header) {
+  const std::string space =
+      options.space.empty() ? (convention == GBufferConvention::Pbrt ? "camera" : "world") : options.space;
+  if (space != "camera" && space != "world")
+    throw InputError(fmt::format("--gbuffer-space '{}': expected camera or world", options.space));
+  std::optional<Eigen::Matrix4d> matrix;
+  if (auto it = header.matrices.find("worldToCamera"); it != header.matrices.end()) {
+    matrix.emplace();
+    for (int i = 0; i < 16; ++i) (*matrix)(i / 4, i % 4) = it->second[size_t(i)];
+  }
+  WorldFromFile out;
+  if (space == "camera") {
+    if (convention != GBufferConvention::Pbrt)
+      throw InputError("--gbuffer-space camera: only pbrt-v4 writes camera space (its header's worldToCamera)");
+    if (!matrix || std::abs(matrix->topLeftCorner<3, 3>().determinant()) < 1e-12)
+      throw InputError(
+          fmt::format("'{}' has no invertible worldToCamera matrix in its header: a pbrt G-buffer in "
+                      "camera space needs it (--gbuffer-space world if its scene says "
+                      "coordinatesystem \"world\")",
+                      options.path));
+    if (!options.cameraOrigin.empty())
+      throw InputError("--camera-origin with a pbrt G-buffer in camera space: its camera is at the origin");
+    out.cameraFromWorld = matrix;
+    return out;
+  }
+  if (!options.cameraOrigin.empty()) {
+    const auto o = parseNumberList("--camera-origin", options.cameraOrigin, options.cameraOrigin, 3, "expected X,Y,Z");
+    out.cameraOrigin = Vec(o[0], o[1], o[2]);
+  } else if (convention == GBufferConvention::Pbrt && matrix) {
+    out.cameraOrigin = (matrix->inverse() * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
+  } else {
+    throw InputError(
+        fmt::format("--gbuffer {} with --convention {}: each pixel's view needs --camera-origin X,Y,Z "
+                    "(the camera's position in the G-buffer's world)",
+                    options.path, options.convention));
+  }
+  return out;
+}
+
+Vec3f toFloat(const Vec& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
+
+Vec inMapFrame(GBufferConvention convention, const Vec& d) {
+  const Vec3d m = toMapFrame(convention, {d.x(), d.y(), d.z()});
+  return Vec(m[0], m[1], m[2]);
+}
+
+}  // namespace
+
+GBufferConvention parseGBufferConvention(const std::string& name) {
+  if (name == "misalloc") return GBufferConvention::Misalloc;
+  if (name == "mitsuba") return GBufferConvention::Mitsuba;
+  if (name == "blender") return GBufferConvention::Blender;
+  if (name == "pbrt") return GBufferConvention::Pbrt;
+  throw InputError(fmt::format("--convention '{}': expected misalloc, mitsuba, blender or pbrt", name));
+}
+
+Vec3d toMapFrame(GBufferConvention convention, const Vec3d& d) {
+  switch (convention) {
+    case GBufferConvention::Mitsuba:
+      return {-d[2], d[0], d[1]};
+    case GBufferConvention::Blender:
+      return {-d[0], d[1], d[2]};
+    case GBufferConvention::Misalloc:
+    case GBufferConvention::Pbrt:
+      break;
+  }
+  return d;
+}
+
+GBufferImage readGBuffer(const GBufferOptions& options) {
+  const GBufferConvention convention = parseGBufferConvention(options.convention);
+  const ExrHeader header = readExrHeader(options.path);
+  const ChannelPrefixes prefixes = channelPrefixes(convention, options, header);
+  const std::vector<std::string> normalNames = xyz(prefixes.normal), positionNames = xyz(prefixes.position);
+  requireChannels(header, normalNames, options.path, "--normal-channels");
+  requireChannels(header, positionNames, options.path, "--position-channels");
+  const WorldFromFile world = worldFromFile(convention, options, header);
+  std::vector<std::string> names = normalNames;
+  names.insert(names.end(), positionNames.begin(), positionNames.end());
+  const bool hasAlpha = std::find(header.channels.begin(), header.channels.end(), "A") != header.channels.end();
+  if (hasAlpha) names.push_back("A");
+  const std::vector<std::vector<float>> planes = readExrChannels(options.path, names);
+
+  GBufferImage out;
+  out.width = header.width;
+  out.height = header.height;
+  const size_t pixels = size_t(out.width) * size_t(out.height);
+  const Vec3f up{0.0f, 0.0f, 1.0f};
+  out.geometry.pixels.assign(pixels, PixelFrame{up, up});
+  out.geometry.covered.assign(pixels, 0);
+  auto where = [&](size_t p) { return fmt::format("x={}, y={}", p % size_t(out.width), p / size_t(out.width)); };
+  for (size_t p = 0; p < pixels; ++p) {
+    const Vec n(planes[0][p], planes[1][p], planes[2][p]), position(planes[3][p], planes[4][p], planes[5][p]);
+    if (hasAlpha && !(planes[6][p] > 0)) continue;
+    if (n.x() == 0 && n.y() == 0 && n.z() == 0) continue;
+    if (!n.allFinite() || !position.allFinite())
+      throw InputError(fmt::format("'{}': the covered pixel at {} has a NaN or infinite normal or position",
+                                   options.path, where(p)));
+    Vec normal, view;
+    if (world.cameraFromWorld) {
+      // Normals by the inverse transpose of camera-from-world's inverse: its transpose.
+      const Eigen::Matrix3d m = world.cameraFromWorld->topLeftCorner<3, 3>();
+      normal = m.transpose() * n;
+      view = m.inverse() * (-position);
+    } else {
+      normal = n;
+      view = *world.cameraOrigin - position;
+    }
+    if (!(view.norm() > 0))
+      throw InputError(
+          fmt::format("'{}': the camera lies on the surface the pixel at {} sees", options.path, where(p)));
+    normal = inMapFrame(convention, normal).normalized();
+    view = inMapFrame(convention, view).normalized();
+    // Two-sided, as pbrt-v4's shading normals and Blender's Normal pass are.
+    if (normal.dot(view) < 0) normal = -normal;
+    const Vec3f nf = toFloat(normal);
+    out.geometry.pixels[p] = PixelFrame{nf, mirrorDirection(nf, toFloat(view))};
+    out.geometry.covered[p] = 1;
+  }
+  if (out.geometry.coveredPixels() == 0)
+    throw InputError(fmt::format("'{}' covers no pixel: every pixel has alpha 0 or a zero normal", options.path));
+  return out;
+}
+
+}  // namespace misalloc

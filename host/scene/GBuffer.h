@@ -1,0 +1,55 @@
+#pragma once
+// G-buffers that renderers write (--gbuffer): each pixel's shading normal, position and
+// coverage in the renderer's world, turned into the map's frame (kernels/envmap.h: z up,
+// u = atan2(y, x)/2π) by the convention that also orients the renderer's lat-long map, so
+// that a G-buffer and a map exported from one renderer are lit as that renderer lights them.
+#include <array>
+#include <string>
+
+#include "scene/SceneGeometry.h"
+
+namespace misalloc {
+
+enum class GBufferConvention { Misalloc, Mitsuba, Blender, Pbrt };
+
+// "misalloc", "mitsuba", "blender" or "pbrt"; throws InputError naming --convention.
+GBufferConvention parseGBufferConvention(const std::string& name);
+
+using Vec3d = std::array<double, 3>;
+
+// A direction of the convention's world in the map's frame: the orthogonal map under which
+// misalloc's lookup of the result is the renderer's lookup of the direction.
+// Mitsuba 3 (src/emitters/envmap.cpp): d = (sin φ sin θ, cos θ, −cos φ sin θ), φ = 2πu,
+// θ = πv, so (x, y, z) → (−z, x, y). Blender: u = (π − atan2(y, x))/2π, top row +z, so
+// (x, y, z) → (−x, y, z). pbrt-v4 (imgtool makeequiarea) and misalloc: the identity.
+Vec3d toMapFrame(GBufferConvention convention, const Vec3d& d);
+
+struct GBufferOptions {
+  std::string path;  // empty: no G-buffer
+  std::string convention = "misalloc";
+  // Channel prefixes of .X, .Y, .Z; empty: the convention's (misalloc N, P; Mitsuba
+  // sh_normal, position; Blender <ViewLayer>.Normal, <ViewLayer>.Position; pbrt Ns, P).
+  std::string normalChannels, positionChannels;
+  // "X,Y,Z" in the G-buffer's world: each pixel is seen from there. pbrt's camera space
+  // has its camera at the origin and needs none.
+  std::string cameraOrigin;
+  // "camera" or "world"; empty: the convention's. pbrt-v4 writes camera space unless its
+  // scene says `coordinatesystem "world"`; its header's worldToCamera takes the frames to
+  // the world. The others write world space.
+  std::string space;
+};
+
+struct GBufferImage {
+  int width = 0, height = 0;
+  SceneGeometry geometry;
+};
+
+// Each pixel's frame (normal turned to face its view, the mirror direction of the view)
+// and coverage: the alpha channel A where the file has one (> 0: covered), and a zero
+// normal marks the background too. Throws InputError before any work on: a missing
+// channel (naming those looked for and those found), a NaN or infinite normal or
+// position on a covered pixel, a camera origin missing where the convention needs one or
+// lying on a covered pixel's surface, a file that covers no pixel.
+GBufferImage readGBuffer(const GBufferOptions& options);
+
+}  // namespace misalloc

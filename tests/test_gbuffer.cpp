@@ -1,0 +1,295 @@
+// G-buffers (scene/GBuffer.h): one physical scene written as each renderer writes it
+// (the test writes the files) reads back as the same frames in the map's frame; each
+// convention's turn of the map is checked against the renderer's own map formula; bad
+// files are refused naming the problem.
+#include <fmt/format.h>
+
+#include <array>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "CliRunner.h"
+#include "Error.h"
+#include "RawExr.h"
+#include "SceneFixtures.h"
+#include "scene/GBuffer.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+constexpr int kWidth = 8, kHeight = 6;
+const Vec3d kCameraOrigin{1, 2, 3};  // in the map's frame
+
+Vec3d toDouble(const Vec3f& v) { return {v[0], v[1], v[2]}; }
+
+// The renderers' own lat-long lookups, written from their formulas (scene/GBuffer.h
+// cites them): the direction each reads at (u, v).
+Vec3d misallocDirection(double u, double v) {
+  const double t = kPi * v, p = 2 * kPi * u;
+  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+}
+Vec3d mitsubaDirection(double u, double v) {
+  const double t = kPi * v, p = 2 * kPi * u;
+  return {std::sin(p) * std::sin(t), std::cos(t), -std::cos(p) * std::sin(t)};
+}
+// Blender: u = (π − atan2(y, x))/2π, v = acos(z)/π.
+Vec3d blenderDirection(double u, double v) {
+  const double t = kPi * v, a = kPi - 2 * kPi * u;
+  return {std::sin(t) * std::cos(a), std::sin(t) * std::sin(a), std::cos(t)};
+}
+
+// A direction of the map's frame in the convention's world: toMapFrame's inverse,
+// written out.
+Vec3d inWorld(GBufferConvention c, const Vec3d& m) {
+  switch (c) {
+    case GBufferConvention::Mitsuba:
+      return {m[1], m[2], -m[0]};
+    case GBufferConvention::Blender:
+      return {-m[0], m[1], m[2]};
+    default:
+      return m;
+  }
+}
+
+double distance(const Vec3d& a, const Vec3d& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+// The scene: random frames in the map's frame, each pixel at a distance along its view
+// from the camera; pixel 5 outside the alpha, pixel 7 with a zero normal; every third
+// normal written facing away from the view (the reader turns it).
+struct TruthScene {
+  std::vector<PixelFrame> frames;
+  std::vector<Vec3d> positions;
+  std::vector<unsigned char> covered;
+};
+
+TruthScene truthScene() {
+  Scene scene = smallScene("constant", "seed000", kWidth, kHeight);
+  giveRandomFrames(scene, 11);
+  TruthScene t{scene.geometry.pixels, {}, std::vector<unsigned char>(kWidth * kHeight, 1)};
+  for (int p = 0; p < kWidth * kHeight; ++p) {
+    const PixelFrame& f = t.frames[size_t(p)];
+    // The view from the mirror direction: ω_o = 2(n·r)n − r.
+    const Vec3f view = mirrorDirection(f.normal, f.mirror);
+    const double d = 2 + 0.1 * p;
+    t.positions.push_back(
+        {kCameraOrigin[0] - d * view[0], kCameraOrigin[1] - d * view[1], kCameraOrigin[2] - d * view[2]});
+  }
+  t.covered[5] = t.covered[7] = 0;
+  return t;
+}
+
+struct Written {
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;
+};
+
+// The scene's normals and positions in a convention's world, under channel prefixes.
+Written inConvention(const TruthScene& t, GBufferConvention c, const std::string& normal, const std::string& position) {
+  Written w{{normal + ".X", normal + ".Y", normal + ".Z", position + ".X", position + ".Y", position + ".Z", "A"},
+            std::vector<std::vector<float>>(7, std::vector<float>(kWidth * kHeight))};
+  for (int p = 0; p < kWidth * kHeight; ++p) {
+    Vec3d n = inWorld(c, toDouble(t.frames[size_t(p)].normal));
+    if (p % 3 == 0) n = {-n[0], -n[1], -n[2]};
+    if (p == 7) n = {0, 0, 0};
+    const Vec3d x = inWorld(c, t.positions[size_t(p)]);
+    for (int k = 0; k < 3; ++k) w.planes[size_t(k)][size_t(p)] = float(n[size_t(k)]);
+    for (int k = 0; k < 3; ++k) w.planes[size_t(3 + k)][size_t(p)] = float(x[size_t(k)]);
+    w.planes[6][size_t(p)] = p == 5 ? 0.0f : 1.0f;
+  }
+  return w;
+}
+
+std::string originIn(GBufferConvention c) {
+  const Vec3d o = inWorld(c, kCameraOrigin);
+  return fmt::format("{},{},{}", o[0], o[1], o[2]);
+}
+
+// Every frame read matches the scene's within float rounding; the coverage exactly.
+void checkFrames(const GBufferImage& read, const TruthScene& t) {
+  REQUIRE(read.width == kWidth);
+  REQUIRE(read.height == kHeight);
+  CHECK(read.geometry.covered == t.covered);
+  double worst = 0;
+  for (size_t p = 0; p < t.frames.size(); ++p) {
+    if (!t.covered[p]) continue;
+    worst = std::max(worst, distance(toDouble(read.geometry.pixels[p].normal), toDouble(t.frames[p].normal)));
+    worst = std::max(worst, distance(toDouble(read.geometry.pixels[p].mirror), toDouble(t.frames[p].mirror)));
+  }
+  CHECK(worst < 2e-5);
+}
+
+}  // namespace
+
+TEST_CASE("each convention turns the renderer's lat-long lookup into misalloc's", "[gbuffer]") {
+  for (double u : {0.0, 0.13, 0.25, 0.5, 0.8})
+    for (double v : {0.1, 0.4, 0.5, 0.9}) {
+      INFO(fmt::format("u {} v {}", u, v));
+      const Vec3d expected = misallocDirection(u, v);
+      CHECK(distance(toMapFrame(GBufferConvention::Mitsuba, mitsubaDirection(u, v)), expected) < 1e-12);
+      CHECK(distance(toMapFrame(GBufferConvention::Blender, blenderDirection(u, v)), expected) < 1e-12);
+      CHECK(distance(toMapFrame(GBufferConvention::Pbrt, expected), expected) == 0);
+    }
+  // The renderers' maps are turned against each other: no convention is another's.
+  CHECK(distance(mitsubaDirection(0.13, 0.4), misallocDirection(0.13, 0.4)) > 0.1);
+  CHECK(distance(blenderDirection(0.13, 0.4), misallocDirection(0.13, 0.4)) > 0.1);
+}
+
+TEST_CASE("one scene written as each renderer writes it reads back as the same frames", "[gbuffer]") {
+  TempDir dir("gbuffer");
+  const TruthScene truth = truthScene();
+  struct Case {
+    GBufferConvention convention;
+    std::string name, normal, position;
+  };
+  const Case cases[] = {{GBufferConvention::Misalloc, "misalloc", "N", "P"},
+                        {GBufferConvention::Mitsuba, "mitsuba", "sh_normal", "position"},
+                        {GBufferConvention::Blender, "blender", "ViewLayer.Normal", "ViewLayer.Position"},
+                        {GBufferConvention::Pbrt, "pbrt", "Ns", "P"}};
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const Written w = inConvention(truth, c.convention, c.normal, c.position);
+    const std::string path = (dir.path / (c.name + ".exr")).string();
+    writeRawChannels(path, kWidth, kHeight, w.names, w.planes);
+    GBufferOptions options;
+    options.path = path;
+    options.convention = c.name;
+    options.cameraOrigin = originIn(c.convention);
+    if (c.convention == GBufferConvention::Pbrt) options.space = "world";
+    checkFrames(readGBuffer(options), truth);
+  }
+  // Mitsuba's AOVs under the user's own names.
+  const Written w = inConvention(truth, GBufferConvention::Mitsuba, "nn", "pos");
+  const std::string path = (dir.path / "named.exr").string();
+  writeRawChannels(path, kWidth, kHeight, w.names, w.planes);
+  GBufferOptions options{path, "mitsuba", "nn", "pos", originIn(GBufferConvention::Mitsuba), ""};
+  checkFrames(readGBuffer(options), truth);
+}
+
+TEST_CASE("pbrt's camera space reads through its header's worldToCamera", "[gbuffer]") {
+  TempDir dir("gbuffer_pbrt");
+  const TruthScene truth = truthScene();
+  // A rotation about (1, 1, 1)/√3 by 40° with z flipped (pbrt's camera space is
+  // left-handed), and the camera at kCameraOrigin: p_camera = R (p − o).
+  const double a = 40 * kPi / 180, c = std::cos(a), s = std::sin(a), k = (1 - c) / 3, q = s / std::sqrt(3.0);
+  const double rotation[3][3] = {{c + k, k - q, k + q}, {k + q, c + k, k - q}, {k - q, k + q, c + k}};
+  double R[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R[i][j] = (i == 2 ? -1 : 1) * rotation[i][j];
+  std::array<float, 16> matrix{};
+  for (int i = 0; i < 3; ++i) {
+    double t = 0;
+    for (int j = 0; j < 3; ++j) matrix[size_t(4 * i + j)] = float(R[i][j]), t -= R[i][j] * kCameraOrigin[size_t(j)];
+    matrix[size_t(4 * i + 3)] = float(t);
+  }
+  matrix[15] = 1;
+  Written w = inConvention(truth, GBufferConvention::Pbrt, "Ns", "P");
+  for (size_t p = 0; p < size_t(kWidth * kHeight); ++p) {
+    double n[3], x[3];
+    for (int i = 0; i < 3; ++i) {
+      n[i] = x[i] = 0;
+      for (int j = 0; j < 3; ++j) {
+        n[i] += R[i][j] * w.planes[size_t(j)][p];
+        x[i] += R[i][j] * (w.planes[size_t(3 + j)][p] - kCameraOrigin[size_t(j)]);
+      }
+    }
+    for (int i = 0; i < 3; ++i) w.planes[size_t(i)][p] = float(n[i]), w.planes[size_t(3 + i)][p] = float(x[i]);
+  }
+  const std::string path = (dir.path / "camera.exr").string();
+  writeRawChannels(path, kWidth, kHeight, w.names, w.planes, {{"worldToCamera", matrix}});
+  GBufferOptions options;
+  options.path = path;
+  options.convention = "pbrt";
+  checkFrames(readGBuffer(options), truth);
+  // The same file read as world space, seen from the camera its header places.
+  options.space = "world";
+  CHECK_NOTHROW(readGBuffer(options));
+}
+
+TEST_CASE("bad G-buffers are refused naming the problem", "[gbuffer][safety]") {
+  TempDir dir("gbuffer_bad");
+  const TruthScene truth = truthScene();
+  auto write = [&](const std::string& name, Written w) {
+    const std::string path = (dir.path / name).string();
+    writeRawChannels(path, kWidth, kHeight, w.names, w.planes);
+    return path;
+  };
+  const Written good = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
+  const std::string origin = originIn(GBufferConvention::Misalloc);
+  auto read = [&](const std::string& path, const std::string& convention, const std::string& cameraOrigin,
+                  const std::string& space = "") {
+    return readGBuffer(GBufferOptions{path, convention, "", "", cameraOrigin, space});
+  };
+  const std::string goodPath = write("good.exr", good);
+  CHECK_THROWS_WITH(read(goodPath, "mitsuba", origin),
+                    Catch::Contains("has no channel sh_normal.X (looked for sh_normal.X, sh_normal.Y, sh_normal.Z; "
+                                    "name others with --normal-channels; channels found: A, N.X"));
+  CHECK_THROWS_WITH(read(goodPath, "blender", origin), Catch::Contains("no <ViewLayer>.Normal.X channel"));
+  CHECK_THROWS_WITH(read(goodPath, "misalloc", ""), Catch::Contains("needs --camera-origin X,Y,Z"));
+  CHECK_THROWS_WITH(read(goodPath, "misalloc", "1,2"), Catch::Contains("--camera-origin"));
+  CHECK_THROWS_WITH(read(goodPath, "misalloc", origin, "camera"), Catch::Contains("only pbrt-v4 writes camera space"));
+  CHECK_THROWS_WITH(read(goodPath, "maya", origin), Catch::Contains("--convention 'maya'"));
+  CHECK_THROWS_WITH(read((dir.path / "none.exr").string(), "misalloc", origin), Catch::Contains("no such file"));
+  const std::string pbrtPath = write("pbrt.exr", inConvention(truth, GBufferConvention::Pbrt, "Ns", "P"));
+  CHECK_THROWS_WITH(read(pbrtPath, "pbrt", ""), Catch::Contains("no invertible worldToCamera"));
+  Written nan = good;
+  nan.planes[1][9] = std::nanf("");
+  CHECK_THROWS_WITH(read(write("nan.exr", nan), "misalloc", origin),
+                    Catch::Contains("the covered pixel at x=1, y=1 has a NaN or infinite normal or position"));
+  Written onCamera = good;
+  for (int k = 0; k < 3; ++k) onCamera.planes[size_t(3 + k)][4] = float(kCameraOrigin[size_t(k)]);
+  CHECK_THROWS_WITH(read(write("camera.exr", onCamera), "misalloc", origin),
+                    Catch::Contains("the camera lies on the surface the pixel at x=4, y=0 sees"));
+  Written empty = good;
+  std::fill(empty.planes[6].begin(), empty.planes[6].end(), 0.0f);
+  CHECK_THROWS_WITH(read(write("empty.exr", empty), "misalloc", origin), Catch::Contains("covers no pixel"));
+  Written layers = inConvention(truth, GBufferConvention::Blender, "A1.Normal", "A1.Position");
+  Written second = inConvention(truth, GBufferConvention::Blender, "B2.Normal", "B2.Position");
+  layers.names.insert(layers.names.end(), second.names.begin(), second.names.end() - 1);
+  layers.planes.insert(layers.planes.end(), second.planes.begin(), second.planes.end() - 1);
+  CHECK_THROWS_WITH(read(write("layers.exr", layers), "blender", origin),
+                    Catch::Contains("several view layers (A1, B2)"));
+}
+
+TEST_CASE("render --gbuffer: one scene as Mitsuba and as misalloc write it renders the same image", "[gbuffer][cli]") {
+  TempDir dir("gbuffer_cli");
+  const TruthScene truth = truthScene();
+  std::vector<std::string> images;
+  for (auto [convention, name, normal, position] :
+       {std::tuple{GBufferConvention::Misalloc, "misalloc", "N", "P"},
+        std::tuple{GBufferConvention::Mitsuba, "mitsuba", "sh_normal", "position"}}) {
+    const Written w = inConvention(truth, convention, normal, position);
+    const std::string gbuffer = (dir.path / fmt::format("{}.exr", name)).string();
+    writeRawChannels(gbuffer, kWidth, kHeight, w.names, w.planes);
+    const std::string out = (dir.path / fmt::format("{}-render.exr", name)).string();
+    auto r =
+        runMisalloc(fmt::format("render --gbuffer {} --convention {} --camera-origin {} --envmap sun --spp 64 "
+                                "--method equal --device cpu --reference none --no-preview --out {} --report {}",
+                                gbuffer, name, originIn(convention), out, (dir.path / "r.json").string()));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    images.push_back(out);
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir.path / "r.json"));
+    CHECK(report["scene"]["covered_pixels"] == kWidth * kHeight - 2);
+    CHECK(report["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
+  }
+  // The same frames to float rounding, the same seed: the same image but where a sample
+  // lands on another texel, far below the noise.
+  const RgbImage a = readExr(images[0]), b = readExr(images[1]);
+  REQUIRE(a.alpha == b.alpha);
+  double difference = 0, magnitude = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i)
+    difference += std::abs(a.rgb[i] - b.rgb[i]), magnitude += std::abs(a.rgb[i]);
+  CHECK(difference < 1e-3 * magnitude);
+  // --size, --view and --scene belong to the G-buffer.
+  auto r = runMisalloc(fmt::format("render --gbuffer {} --size 8x6 --camera-origin 1,2,3 --out {}",
+                                   (dir.path / "misalloc.exr").string(), (dir.path / "x.exr").string()));
+  CHECK(r.exitCode == 2);
+  CHECK(r.output.find("--gbuffer with --size") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "x.exr"));
+}
