@@ -292,4 +292,75 @@ TEST_CASE("render --gbuffer: one scene as Mitsuba and as misalloc write it rende
   CHECK(r.exitCode == 2);
   CHECK(r.output.find("--gbuffer with --size") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir.path / "x.exr"));
+  // --grid beside a G-buffer that holds each pixel's BRDF.
+  Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
+  w.names.insert(w.names.end(), {"rho_d", "rho_s", "phong_n"});
+  w.planes.resize(w.planes.size() + 3, std::vector<float>(size_t(kWidth * kHeight), 0.5f));
+  const std::string brdf = (dir.path / "brdf.exr").string();
+  writeRawChannels(brdf, kWidth, kHeight, w.names, w.planes);
+  r = runMisalloc(fmt::format("render --gbuffer {} --camera-origin {} --grid seed000 --out {}", brdf,
+                              originIn(GBufferConvention::Misalloc), (dir.path / "x.exr").string()));
+  CHECK(r.exitCode == 2);
+  CHECK(r.output.find("--grid with --gbuffer") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir.path / "x.exr"));
+}
+
+TEST_CASE("a G-buffer's BRDF channels give each pixel its BRDF, its UV channels lay the grid over it", "[gbuffer]") {
+  TempDir dir("gbuffer_brdf");
+  const TruthScene truth = truthScene();
+  const size_t pixels = kWidth * kHeight;
+  SceneOptions o;
+  o.envmap = "constant";
+  o.proceduralWidth = 64;
+  o.gbuffer.convention = "misalloc";
+  o.gbuffer.cameraOrigin = originIn(GBufferConvention::Misalloc);
+  SECTION("BRDF channels") {
+    Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
+    w.names.insert(w.names.end(), {"rho_d", "rho_s", "phong_n"});
+    w.planes.resize(w.planes.size() + 3, std::vector<float>(pixels));
+    for (size_t p = 0; p < pixels; ++p) {
+      w.planes[7][p] = 0.01f * float(p);
+      w.planes[8][p] = 0.5f;
+      w.planes[9][p] = p == 5 ? -1.0f : float(p);  // pixel 5 is background: not checked
+    }
+    o.gbuffer.path = (dir.path / "brdf.exr").string();
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    const Scene scene = makeScene(o);
+    CHECK(scene.grid.spec == kGBufferBrdf);
+    for (size_t p : {size_t(0), size_t(9), pixels - 1}) {
+      INFO(p);
+      CHECK(scene.grid.pixels[p].rhoD == w.planes[7][p]);
+      CHECK(scene.grid.pixels[p].rhoS == 0.5f);
+      CHECK(scene.grid.pixels[p].n == w.planes[9][p]);
+    }
+    // A covered pixel's BRDF that is none, and some channels without the others.
+    w.planes[8][9] = 0.95f;
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    CHECK_THROWS_WITH(makeScene(o), Catch::Contains("the covered pixel at x=1, y=1 has rho_d 0.09, rho_s 0.95"));
+    w.names.pop_back();
+    w.planes.pop_back();
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    CHECK_THROWS_WITH(makeScene(o),
+                      Catch::Contains("holds some of the BRDF channels rho_d, rho_s, phong_n but not all"));
+  }
+  SECTION("UV channels") {
+    Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
+    w.names.insert(w.names.end(), {"uv.U", "uv.V"});
+    w.planes.resize(w.planes.size() + 2, std::vector<float>(pixels));
+    std::vector<SurfaceUv> uv;
+    for (size_t p = 0; p < pixels; ++p) {
+      w.planes[7][p] = 1.0f + 0.02f * float(p);  // wrapped into [0, 1)
+      w.planes[8][p] = 0.5f - 0.01f * float(p);
+      uv.push_back({double(w.planes[7][p]) - 1, double(w.planes[8][p])});
+    }
+    o.gbuffer.path = (dir.path / "uv.exr").string();
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    const Scene scene = makeScene(o);
+    const BrdfGrid expected = makeBrdfGrid("seed000", kWidth, kHeight, uv);
+    size_t mismatches = 0;
+    for (size_t p = 0; p < pixels; ++p)
+      mismatches += std::abs(scene.grid.pixels[p].rhoD - expected.pixels[p].rhoD) > 1e-6f ||
+                    std::abs(scene.grid.pixels[p].n - expected.pixels[p].n) > 1e-4f * expected.pixels[p].n;
+    CHECK(mismatches == 0);
+  }
 }

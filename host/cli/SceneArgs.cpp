@@ -93,6 +93,11 @@ SceneOptions SceneArgs::parsed() {
 Scene SceneArgs::make() {
   parsed();
   Scene scene = makeScene(options);
+  if (scene.grid.spec == kGBufferBrdf && app && app->count("--grid") > 0)
+    throw InputError(
+        fmt::format("--grid with --gbuffer {}: the G-buffer holds each pixel's BRDF (its channels "
+                    "rho_d, rho_s, phong_n)",
+                    options.gbuffer.path));
   const ReadWarnings& repaired = scene.envmapWarnings;
   if (repaired.negativeValues > 0)
     std::cerr << fmt::format("misalloc: warning: {}: {} negative values set to 0 (first at {})\n", scene.envmapPath,

@@ -102,7 +102,7 @@ nlohmann::json sceneJson(const Scene& scene) {
                          {"envmap_size", {scene.tables.width, scene.tables.height}},
                          {"envmap_uniform_fallback", scene.tables.uniformFallback},
                          {"envmap_negative_values_zeroed", scene.envmapWarnings.negativeValues},
-                         {"grid", o.grid},
+                         {"grid", scene.grid.spec},
                          {"shape", o.shape},
                          {"size", {o.width, o.height}},
                          {"covered_pixels", scene.geometry.coveredPixels()},

@@ -73,6 +73,42 @@ void requireChannels(const ExrHeader& header, const std::vector<std::string>& na
                                    path, n, fmt::join(names, ", "), option, fmt::join(header.channels, ", ")));
 }
 
+const std::vector<std::string> kBrdfChannels{"rho_d", "rho_s", "phong_n"};
+
+bool hasChannel(const ExrHeader& header, const std::string& name) {
+  return std::find(header.channels.begin(), header.channels.end(), name) != header.channels.end();
+}
+
+// The BRDF channels, all or none.
+bool hasBrdfChannels(const ExrHeader& header, const std::string& path) {
+  const auto present = std::count_if(kBrdfChannels.begin(), kBrdfChannels.end(),
+                                     [&](const std::string& c) { return hasChannel(header, c); });
+  if (present > 0 && present < 3)
+    throw InputError(fmt::format("'{}' holds some of the BRDF channels {} but not all (channels found: {})", path,
+                                 fmt::join(kBrdfChannels, ", "), fmt::join(header.channels, ", ")));
+  return present == 3;
+}
+
+// The convention's UV channels, where the file has them.
+std::vector<std::string> uvChannels(GBufferConvention convention, const ChannelPrefixes& prefixes,
+                                    const ExrHeader& header) {
+  std::vector<std::string> names{"uv.U", "uv.V"};
+  if (convention == GBufferConvention::Pbrt) names = {"u", "v"};
+  if (convention == GBufferConvention::Blender) {
+    const std::string layer = prefixes.normal.substr(0, prefixes.normal.rfind('.'));
+    names = {layer + ".UV.U", layer + ".UV.V"};
+  }
+  return hasChannel(header, names[0]) && hasChannel(header, names[1]) ? names : std::vector<std::string>{};
+}
+
+void checkBrdf(const PhongParameters& b, const std::string& path, const std::string& where) {
+  if (!(b.rhoD >= 0 && b.rhoS >= 0 && b.rhoD + b.rhoS <= 1 + 1e-6 && b.n >= 0 && b.n <= 1e5))
+    throw InputError(
+        fmt::format("'{}': the covered pixel at {} has rho_d {:g}, rho_s {:g}, phong_n {:g}: a BRDF needs "
+                    "ρd, ρs ≥ 0, ρd + ρs ≤ 1 and n in [0, 1e5]",
+                    path, where, b.rhoD, b.rhoS, b.n));
+}
+
 // The frames' way into the convention's world: camera space through the header's matrix.
 struct WorldFromFile {
   std::optional<Eigen::Matrix4d> cameraFromWorld;  // camera space; none: world space
@@ -158,8 +194,14 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   const WorldFromFile world = worldFromFile(convention, options, header);
   std::vector<std::string> names = normalNames;
   names.insert(names.end(), positionNames.begin(), positionNames.end());
-  const bool hasAlpha = std::find(header.channels.begin(), header.channels.end(), "A") != header.channels.end();
+  const bool hasAlpha = hasChannel(header, "A"), hasBrdf = hasBrdfChannels(header, options.path);
+  const std::vector<std::string> uvNames =
+      hasBrdf ? std::vector<std::string>{} : uvChannels(convention, prefixes, header);
   if (hasAlpha) names.push_back("A");
+  const size_t brdfPlane = names.size();
+  if (hasBrdf) names.insert(names.end(), kBrdfChannels.begin(), kBrdfChannels.end());
+  const size_t uvPlane = names.size();
+  names.insert(names.end(), uvNames.begin(), uvNames.end());
   const std::vector<std::vector<float>> planes = readExrChannels(options.path, names);
 
   GBufferImage out;
@@ -170,6 +212,11 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   out.geometry.pixels.assign(pixels, PixelFrame{up, up});
   out.geometry.covered.assign(pixels, 0);
   auto where = [&](size_t p) { return fmt::format("x={}, y={}", p % size_t(out.width), p / size_t(out.width)); };
+  if (hasBrdf) out.brdf.assign(pixels, PhongParameters{0, 0, 1});
+  for (size_t p = 0; p < pixels && !uvNames.empty(); ++p) {
+    const double u = planes[uvPlane][p], v = planes[uvPlane + 1][p];
+    out.uv.push_back({std::isfinite(u) ? u - std::floor(u) : 0.0, std::isfinite(v) ? v - std::floor(v) : 0.0});
+  }
   for (size_t p = 0; p < pixels; ++p) {
     const Vec n(planes[0][p], planes[1][p], planes[2][p]), position(planes[3][p], planes[4][p], planes[5][p]);
     if (hasAlpha && !(planes[6][p] > 0)) continue;
@@ -197,6 +244,10 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
     const Vec3f nf = toFloat(normal);
     out.geometry.pixels[p] = PixelFrame{nf, mirrorDirection(nf, toFloat(view))};
     out.geometry.covered[p] = 1;
+    if (hasBrdf) {
+      out.brdf[p] = {planes[brdfPlane][p], planes[brdfPlane + 1][p], planes[brdfPlane + 2][p]};
+      checkBrdf(out.brdf[p], options.path, where(p));
+    }
   }
   if (out.geometry.coveredPixels() == 0)
     throw InputError(fmt::format("'{}' covers no pixel: every pixel has alpha 0 or a zero normal", options.path));

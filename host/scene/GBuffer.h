@@ -6,6 +6,7 @@
 #include <array>
 #include <string>
 
+#include "scene/BrdfGrid.h"
 #include "scene/SceneGeometry.h"
 
 namespace misalloc {
@@ -42,6 +43,12 @@ struct GBufferOptions {
 struct GBufferImage {
   int width = 0, height = 0;
   SceneGeometry geometry;
+  // The BRDF per pixel where the file holds channels rho_d, rho_s and phong_n; else
+  // empty, and `uv` where it holds the convention's UV channels (misalloc, Mitsuba uv.U,
+  // uv.V; Blender <ViewLayer>.UV.U, .V; pbrt u, v), wrapped into [0, 1), over which
+  // --grid is laid; else both empty, and the grid lies over the image.
+  std::vector<PhongParameters> brdf;
+  std::vector<SurfaceUv> uv;
 };
 
 // Each pixel's frame (normal turned to face its view, the mirror direction of the view)
@@ -49,7 +56,8 @@ struct GBufferImage {
 // normal marks the background too. Throws InputError before any work on: a missing
 // channel (naming those looked for and those found), a NaN or infinite normal or
 // position on a covered pixel, a camera origin missing where the convention needs one or
-// lying on a covered pixel's surface, a file that covers no pixel.
+// lying on a covered pixel's surface, a file that covers no pixel, some BRDF channels
+// without the others, a covered pixel's BRDF outside ρd, ρs ≥ 0, ρd + ρs ≤ 1, n ∈ [0, 10⁵].
 GBufferImage readGBuffer(const GBufferOptions& options);
 
 }  // namespace misalloc

@@ -102,7 +102,12 @@ Scene makeScene(const SceneOptions& options) {
     GBufferImage gbuffer = readGBuffer(options.gbuffer);
     scene.options.width = gbuffer.width;
     scene.options.height = gbuffer.height;
-    scene.grid = makeBrdfGrid(options.grid, gbuffer.width, gbuffer.height);
+    if (!gbuffer.brdf.empty())
+      scene.grid = BrdfGrid{kGBufferBrdf, gbuffer.width, gbuffer.height, std::move(gbuffer.brdf)};
+    else if (!gbuffer.uv.empty())
+      scene.grid = makeBrdfGrid(options.grid, gbuffer.width, gbuffer.height, gbuffer.uv);
+    else
+      scene.grid = makeBrdfGrid(options.grid, gbuffer.width, gbuffer.height);
     scene.geometry = std::move(gbuffer.geometry);
   } else {
     ShapeImage shape =
