@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
   // the subcommands are added: they copy it.
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   const std::vector<Subcommand> subcommands{addDevicesCommand(app), addRenderCommand(app), addReferenceCommand(app),
-                                            addCompareCommand(app), addPaperCommand(app), addMergeCommand(app)};
+                                            addCompareCommand(app), addPaperCommand(app),  addMergeCommand(app),
+                                            addGBufferCommand(app)};
   try {
     refuseUnknownSubcommand(app, argc, argv);
     app.parse(argc, argv);

@@ -17,9 +17,9 @@
 #include "OutputSet.h"
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
-#include "cli/EnvmapInputs.h"
 #include "cli/RunIdentity.h"
 #include "cli/SceneArgs.h"
+#include "cli/SceneInputs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
 #include "compare/CompareReport.h"
@@ -83,6 +83,7 @@ int runCompare(CompareArgs& args) {
     for (CompareCase c : suiteCases(probe.grid.width, probe.grid.height)) {
       c.scene.shape = probe.options.shape;
       c.scene.gbuffer = probe.options.gbuffer;
+      c.scene.mesh = probe.options.mesh;
       c.scene.viewTheta = probe.options.viewTheta;
       c.scene.viewPhi = probe.options.viewPhi;
       c.scene.product = probe.options.product;  // the suite with the product technique in every case
@@ -141,7 +142,7 @@ int runCompare(CompareArgs& args) {
   }
   std::vector<SceneOptions> scenes;
   for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
-  std::vector<NamedFile> inputs = envmapInputs(scenes);
+  std::vector<NamedFile> inputs = sceneInputs(scenes);
   inputs.push_back({"--cache-dir", compare.cacheDir});
   OutputSet outputs(inputs);
   const std::string outDir = compare.outDir;

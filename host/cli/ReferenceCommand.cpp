@@ -6,12 +6,12 @@
 #include <iostream>
 #include <memory>
 
-#include "OptionRange.h"
 #include "Interruption.h"
+#include "OptionRange.h"
 #include "OutputSet.h"
 #include "cli/DeviceArgs.h"
-#include "cli/EnvmapInputs.h"
 #include "cli/SceneArgs.h"
+#include "cli/SceneInputs.h"
 #include "cli/Subcommand.h"
 #include "render/Reference.h"
 #include "scene/ExrIO.h"
@@ -28,7 +28,7 @@ struct ReferenceArgs {
 
 int runReference(ReferenceArgs& args) {
   exitOnInterrupt();
-  OutputSet outputs(envmapInputs({args.scene.parsed()}));
+  OutputSet outputs(sceneInputs({args.scene.parsed()}));
   if (!args.out.empty()) outputs.claim("--out", args.out);
   args.scene.options.bankCacheDir = args.cacheDir;
   Scene scene = args.scene.make();
@@ -53,7 +53,8 @@ Subcommand addReferenceCommand(CLI::App& app) {
   args->scene.add(*command);
   command->add_option("--spp", args->spp, "samples per pixel")->capture_default_str()->check(integerIn(1, INT_MAX));
   args->devices.add(*command, "comma-separated: auto, cpu, gpu, index, host, all or D:N");
-  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
+  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")
+      ->capture_default_str();
   command->add_option("--out", args->out, "also write the reference to this EXR");
   return {command, [args] { return runReference(*args); }};
 }

@@ -14,9 +14,9 @@
 #include "OutputSet.h"
 #include "cli/AdaptiveArgs.h"
 #include "cli/DeviceArgs.h"
-#include "cli/EnvmapInputs.h"
 #include "cli/RunIdentity.h"
 #include "cli/SceneArgs.h"
+#include "cli/SceneInputs.h"
 #include "cli/StatisticsMemory.h"
 #include "cli/Subcommand.h"
 #include "render/Band.h"
@@ -80,7 +80,7 @@ int runRender(RenderArgs& args) {
   const MethodTraits& traits = methodTraits(m);
   const Estimator estimator = parseEstimator(args.estimator);
   if (traits.envmapOnly) args.scene.usePlainPdfByDefault();  // the optimal pdf does not cover f alone
-  std::vector<NamedFile> inputs = envmapInputs({args.scene.parsed()});
+  std::vector<NamedFile> inputs = sceneInputs({args.scene.parsed()});
   if (args.reference != "auto" && args.reference != "none") inputs.push_back({"--reference", args.reference});
   OutputSet outputs(inputs);
   outputs.claim("--out", args.out);
@@ -200,7 +200,8 @@ Subcommand addRenderCommand(CLI::App& app) {
   command->add_option("--reference-spp", args->referenceSpp, "spp of a sampled reference")
       ->capture_default_str()
       ->check(integerIn(1, INT_MAX));
-  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")->capture_default_str();
+  command->add_option("--cache-dir", args->cacheDir, "where references and the optimal pdf's tables are cached")
+      ->capture_default_str();
   command->add_option("--local-size", args->localSize, kLocalSizeHelp)->check(integerIn(1, INT_MAX));
   command->add_option("--shard", args->shard,
                       "K/N: render band K of N (whole rows of 16-pixel blocks) into --out, for `misalloc merge`");

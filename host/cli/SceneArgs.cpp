@@ -40,6 +40,13 @@ void SceneArgs::add(CLI::App& command) {
                      "the G-buffer's position channels' prefix (PREFIX.X/Y/Z), if not the convention's");
   command.add_option("--camera-origin", options.gbuffer.cameraOrigin,
                      "X,Y,Z: the camera's position in the G-buffer's world (pbrt: from its header)");
+  command.add_option("--mesh", options.mesh.path,
+                     "a triangle mesh (OBJ, PLY, ...) instead of --scene, seen by a pinhole camera from "
+                     "--camera-origin, in --convention's world");
+  command.add_option("--camera-target", options.mesh.target, "X,Y,Z: where the mesh's camera looks")
+      ->capture_default_str();
+  command.add_option("--fov", options.mesh.verticalFovDegrees, "the mesh's camera's vertical field of view, degrees")
+      ->capture_default_str();
   command.add_option("--gbuffer-space", options.gbuffer.space,
                      "camera or world: pbrt-v4's G-buffer space (default camera, pbrt's own default)");
   command.add_option("--size", size, "WxH pixels")->capture_default_str();
@@ -75,6 +82,8 @@ SceneOptions SceneArgs::parsed() {
     for (const char* option : {"--size", "--view", "--scene"})
       if (app && app->count(option) > 0)
         throw InputError(fmt::format("--gbuffer with {}: the G-buffer sets the image and each pixel's view", option));
+  if (!options.mesh.path.empty() && app && app->count("--view") > 0)
+    throw InputError("--mesh with --view: the camera (--camera-origin, --camera-target) sets each pixel's view");
   const SceneShape shape = parseSceneShape(options.shape);
   if (view.empty()) view = fmt::format("{}", defaultViewTheta(shape));
   std::vector<double> angles = parseNumberList("--view", view, view, 0, "expected THETA[,PHI] in degrees");

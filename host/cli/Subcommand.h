@@ -19,5 +19,6 @@ Subcommand addReferenceCommand(CLI::App& app);  // ReferenceCommand.cpp
 Subcommand addCompareCommand(CLI::App& app);    // CompareCommand.cpp
 Subcommand addPaperCommand(CLI::App& app);      // PaperCommand.cpp
 Subcommand addMergeCommand(CLI::App& app);      // MergeCommand.cpp
+Subcommand addGBufferCommand(CLI::App& app);    // GBufferCommand.cpp
 
 }  // namespace misalloc

@@ -11,6 +11,7 @@ std::string caseLabel(const SceneOptions& scene) {
     name = std::filesystem::path(name).stem().string();
   if (scene.shape != "plane") name += "-" + scene.shape;
   if (!scene.gbuffer.path.empty()) name += "-" + std::filesystem::path(scene.gbuffer.path).stem().string();
+  if (!scene.mesh.path.empty()) name += "-" + std::filesystem::path(scene.mesh.path).stem().string();
   for (char& ch : name)
     if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_' && ch != '-') ch = '_';
   if (scene.sampler == EnvmapSampler::Cdf) name += "-cdf";

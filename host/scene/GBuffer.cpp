@@ -188,10 +188,13 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   const GBufferConvention convention = parseGBufferConvention(options.convention);
   const ExrHeader header = readExrHeader(options.path);
   const ChannelPrefixes prefixes = channelPrefixes(convention, options, header);
-  const std::vector<std::string> normalNames = xyz(prefixes.normal), positionNames = xyz(prefixes.position);
+  const std::vector<std::string> normalNames = xyz(prefixes.normal), viewNames = xyz("view");
+  const bool hasView =
+      std::all_of(viewNames.begin(), viewNames.end(), [&](const std::string& c) { return hasChannel(header, c); });
+  const std::vector<std::string> positionNames = hasView ? viewNames : xyz(prefixes.position);
   requireChannels(header, normalNames, options.path, "--normal-channels");
   requireChannels(header, positionNames, options.path, "--position-channels");
-  const WorldFromFile world = worldFromFile(convention, options, header);
+  const WorldFromFile world = hasView ? WorldFromFile{} : worldFromFile(convention, options, header);
   std::vector<std::string> names = normalNames;
   names.insert(names.end(), positionNames.begin(), positionNames.end());
   const bool hasAlpha = hasChannel(header, "A"), hasBrdf = hasBrdfChannels(header, options.path);
@@ -225,7 +228,10 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
       throw InputError(fmt::format("'{}': the covered pixel at {} has a NaN or infinite normal or position",
                                    options.path, where(p)));
     Vec normal, view;
-    if (world.cameraFromWorld) {
+    if (hasView) {
+      normal = n;
+      view = position;  // the view channels, read in the positions' place
+    } else if (world.cameraFromWorld) {
       // Normals by the inverse transpose of camera-from-world's inverse: its transpose.
       const Eigen::Matrix3d m = world.cameraFromWorld->topLeftCorner<3, 3>();
       normal = m.transpose() * n;
@@ -252,6 +258,24 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   if (out.geometry.coveredPixels() == 0)
     throw InputError(fmt::format("'{}' covers no pixel: every pixel has alpha 0 or a zero normal", options.path));
   return out;
+}
+
+std::string encodeGBuffer(int width, int height, const SceneGeometry& geometry,
+                          const std::vector<PhongParameters>& brdf) {
+  const std::vector<std::string> names{"N.X",    "N.Y", "N.Z",   "view.X", "view.Y",
+                                       "view.Z", "A",   "rho_d", "rho_s",  "phong_n"};
+  const size_t pixels = geometry.pixels.size();
+  std::vector<std::vector<float>> planes(names.size(), std::vector<float>(pixels, 0.0f));
+  for (size_t p = 0; p < pixels; ++p) {
+    if (!geometry.covered[p]) continue;
+    const PixelFrame& f = geometry.pixels[p];
+    // The mirror direction's own mirror: the view.
+    const Vec3f view = mirrorDirection(f.normal, f.mirror);
+    const float values[] = {f.normal[0], f.normal[1], f.normal[2],  view[0],      view[1],
+                            view[2],     1.0f,        brdf[p].rhoD, brdf[p].rhoS, brdf[p].n};
+    for (size_t k = 0; k < names.size(); ++k) planes[k][p] = values[k];
+  }
+  return encodeExrChannels(width, height, names, planes);
 }
 
 }  // namespace misalloc

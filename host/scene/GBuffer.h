@@ -52,12 +52,20 @@ struct GBufferImage {
 };
 
 // Each pixel's frame (normal turned to face its view, the mirror direction of the view)
-// and coverage: the alpha channel A where the file has one (> 0: covered), and a zero
+// and coverage; the view from the channels view.X, .Y, .Z (towards the camera) where the
+// file has them, which then needs neither positions nor a camera; else from the position
+// to the camera. Coverage: the alpha channel A where the file has one (> 0: covered), and a zero
 // normal marks the background too. Throws InputError before any work on: a missing
 // channel (naming those looked for and those found), a NaN or infinite normal or
 // position on a covered pixel, a camera origin missing where the convention needs one or
 // lying on a covered pixel's surface, a file that covers no pixel, some BRDF channels
 // without the others, a covered pixel's BRDF outside ρd, ρs ≥ 0, ρd + ρs ≤ 1, n ∈ [0, 10⁵].
 GBufferImage readGBuffer(const GBufferOptions& options);
+
+// The G-buffer of a scene as misalloc reads it back (--gbuffer, convention misalloc): N,
+// view (towards the camera), A, and the BRDF's rho_d, rho_s, phong_n; the background's
+// all 0.
+std::string encodeGBuffer(int width, int height, const SceneGeometry& geometry,
+                          const std::vector<PhongParameters>& brdf);
 
 }  // namespace misalloc

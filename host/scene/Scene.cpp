@@ -17,7 +17,7 @@ namespace misalloc {
 namespace fs = std::filesystem;
 
 bool SceneOptions::perPixelGeometry() const {
-  return !gbuffer.path.empty() || parseSceneShape(shape).kind != SceneShape::Plane;
+  return !gbuffer.path.empty() || !mesh.path.empty() || parseSceneShape(shape).kind != SceneShape::Plane;
 }
 
 EnvmapPdf defaultEnvmapPdf(const SceneOptions& options) {
@@ -97,7 +97,13 @@ Scene makeScene(const SceneOptions& options) {
         "and the BRDF's lobes split and the product make 4");
   Scene scene;
   scene.options = options;
-  if (!options.gbuffer.path.empty()) {
+  if (!options.mesh.path.empty()) {
+    if (options.shape != "plane" || !options.gbuffer.path.empty())
+      throw InputError("--mesh with --scene or --gbuffer: the mesh is the scene; drop one");
+    GBufferImage seen = rasteriseMesh(options.mesh, options.gbuffer, options.width, options.height);
+    scene.grid = makeBrdfGrid(options.grid, options.width, options.height);
+    scene.geometry = std::move(seen.geometry);
+  } else if (!options.gbuffer.path.empty()) {
     if (options.shape != "plane") throw InputError("--gbuffer with --scene: the G-buffer is the scene; drop one");
     GBufferImage gbuffer = readGBuffer(options.gbuffer);
     scene.options.width = gbuffer.width;

@@ -8,6 +8,7 @@
 #include "scene/BrdfGrid.h"
 #include "scene/Envmap.h"
 #include "scene/GBuffer.h"
+#include "scene/Mesh.h"
 #include "scene/SceneGeometry.h"
 
 namespace misalloc {
@@ -17,6 +18,7 @@ struct SceneOptions {
   std::string grid = "seed000";
   std::string shape = "plane";  // --scene (scene/SceneShape.h)
   GBufferOptions gbuffer;       // --gbuffer: each pixel's frame read from a file instead of a shape
+  MeshOptions mesh;             // --mesh: a mesh seen from gbuffer.cameraOrigin, in gbuffer.convention's world
   int width = 128, height = 128;
   double viewTheta = 0, viewPhi = 0;  // ω_o in degrees (shapeImage)
   bool splitBrdf = false;             // M = 3: the BRDF's lobes as techniques of their own
