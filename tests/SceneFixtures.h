@@ -17,20 +17,26 @@
 
 namespace misalloc::test {
 
-inline Scene smallScene(const std::string& envmap, const std::string& grid, int w, int h, bool split = false,
-                        EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0,
-                        const std::string& envmapPdf = "plain", bool product = false) {
+// A small scene's options: a procedural map of 128 texels across.
+inline SceneOptions smallSceneOptions(const std::string& envmap, const std::string& grid, int w, int h) {
   SceneOptions o;
-  o.envmapPdf = parseEnvmapPdf(envmapPdf);
   o.envmap = envmap;
   o.grid = grid;
   o.width = w;
   o.height = h;
+  o.proceduralWidth = 128;
+  return o;
+}
+
+inline Scene smallScene(const std::string& envmap, const std::string& grid, int w, int h, bool split = false,
+                        EnvmapSampler sampler = EnvmapSampler::Alias, double viewTheta = 0,
+                        const std::string& envmapPdf = "plain", bool product = false) {
+  SceneOptions o = smallSceneOptions(envmap, grid, w, h);
+  o.envmapPdf = parseEnvmapPdf(envmapPdf);
   o.splitBrdf = split;
   o.product = product;
   o.sampler = sampler;
   o.viewTheta = viewTheta;
-  o.proceduralWidth = 128;
   return makeScene(o);
 }
 

@@ -54,13 +54,13 @@ TEST_CASE("bands of whole block rows, their halo, and the shard option", "[band]
 TEST_CASE("merged bands are the unsharded render bit for bit, for every method", "[band][cli]") {
   TempDir dir("band");
   // One of each kind of allocation a band computes: none, a per-pixel rule, the oracle,
-  // the grid search alone (on spheres, whose bands hold background) and pooled over a
+  // the grid search alone (on a G-buffer of spheres, whose bands hold background) and pooled over a
   // halo of stages, the optimal weights' pilot (the other rules and fixed counts take
   // the same paths: the whole set with MISALLOC_TEST_SIZE=exhaustive).
   std::vector<std::string> variants{"equal",
                                     "heuristic",
                                     "oracle",
-                                    "exact --scene spheres:2x4",
+                                    "exact --gbuffer " + (dir.path / "spheres.exr").string(),
                                     "exact --stages 3 --pool 3",
                                     "exact --stages 3 --pool 3 --weights optimal"};
   if (exhaustiveTestSize())
@@ -78,6 +78,9 @@ TEST_CASE("merged bands are the unsharded render bit for bit, for every method",
   // Under the sanitizers: a fixed split with background, the widest halo and the optimal weights' pooled
   // pilot, the same code paths.
   if (smallTestSize()) variants = {"equal --scene spheres:2x4", "exact --stages 3 --pool 3", "equal --weights optimal"};
+  const auto spheres = runMisalloc(
+      fmt::format("gbuffer --scene spheres:2x4 --size 16x40 --out {}", (dir.path / "spheres.exr").string()));
+  REQUIRE(spheres.exitCode == 0);
   for (const std::string& variant : variants) {
     const std::string method = variant.substr(0, variant.find(' '));
     const std::string extra = variant.size() > method.size() ? variant.substr(method.size()) : "";

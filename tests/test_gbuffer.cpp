@@ -124,6 +124,16 @@ void checkFrames(const GBufferImage& read, const TruthScene& t) {
   CHECK(worst < 2e-5);
 }
 
+// Σ|a − b| / Σ|a| over two images of the same coverage.
+double relativeDifference(const std::string& pathA, const std::string& pathB) {
+  const RgbImage a = readExr(pathA), b = readExr(pathB);
+  REQUIRE(a.alpha == b.alpha);
+  double difference = 0, magnitude = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i)
+    difference += std::abs(a.rgb[i] - b.rgb[i]), magnitude += std::abs(a.rgb[i]);
+  return difference / magnitude;
+}
+
 }  // namespace
 
 TEST_CASE("each convention turns the renderer's lat-long lookup into misalloc's", "[gbuffer]") {
@@ -280,17 +290,18 @@ TEST_CASE("render --gbuffer: one scene as Mitsuba and as misalloc write it rende
   }
   // The same frames to float rounding, the same seed: the same image but where a sample
   // lands on another texel, far below the noise.
-  const RgbImage a = readExr(images[0]), b = readExr(images[1]);
-  REQUIRE(a.alpha == b.alpha);
-  double difference = 0, magnitude = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i)
-    difference += std::abs(a.rgb[i] - b.rgb[i]), magnitude += std::abs(a.rgb[i]);
-  CHECK(difference < 1e-3 * magnitude);
-  // --size, --view and --scene belong to the G-buffer.
-  auto r = runMisalloc(fmt::format("render --gbuffer {} --size 8x6 --camera-origin 1,2,3 --out {}",
+  CHECK(relativeDifference(images[0], images[1]) < 1e-3);
+  // --view and --scene belong to the G-buffer, and its size to --size where given.
+  auto r = runMisalloc(fmt::format("render --gbuffer {} --view 10 --camera-origin 1,2,3 --out {}",
                                    (dir.path / "misalloc.exr").string(), (dir.path / "x.exr").string()));
   CHECK(r.exitCode == 2);
-  CHECK(r.output.find("--gbuffer with --size") != std::string::npos);
+  CHECK(r.output.find("--gbuffer with --view") != std::string::npos);
+  r = runMisalloc(fmt::format("render --gbuffer {} --size 6x8 --camera-origin {} --out {}",
+                              (dir.path / "misalloc.exr").string(), originIn(GBufferConvention::Misalloc),
+                              (dir.path / "x.exr").string()));
+  CHECK(r.exitCode == 2);
+  CHECK(r.output.find("--size 6x8: the G-buffer") != std::string::npos);
+  CHECK(r.output.find("is 8x6") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir.path / "x.exr"));
   // --grid beside a G-buffer that holds each pixel's BRDF.
   Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
@@ -384,12 +395,7 @@ TEST_CASE("misalloc gbuffer writes a scene that render --gbuffer renders as the 
   }
   // The view written and the mirror direction read back differ from the scene's by float
   // rounding only: the same image but where a sample lands on another texel.
-  const RgbImage a = readExr(images[0]), b = readExr(images[1]);
-  REQUIRE(a.alpha == b.alpha);
-  double difference = 0, magnitude = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i)
-    difference += std::abs(a.rgb[i] - b.rgb[i]), magnitude += std::abs(a.rgb[i]);
-  CHECK(difference < 1e-3 * magnitude);
+  CHECK(relativeDifference(images[0], images[1]) < 1e-3);
   // It never replaces its own input.
   r = runMisalloc(fmt::format("gbuffer --gbuffer {0} --out {0}", gbuffer));
   CHECK(r.exitCode == 2);

@@ -24,15 +24,10 @@ namespace {
 
 Scene shapeScene(const std::string& shape, const std::string& envmap, const std::string& grid, int w, int h,
                  double viewTheta = 75, double viewPhi = 0) {
-  SceneOptions o;
+  SceneOptions o = smallSceneOptions(envmap, grid, w, h);
   o.shape = shape;
-  o.envmap = envmap;
-  o.grid = grid;
-  o.width = w;
-  o.height = h;
   o.viewTheta = viewTheta;
   o.viewPhi = viewPhi;
-  o.proceduralWidth = 128;
   return makeScene(o);
 }
 

@@ -79,9 +79,9 @@ SceneOptions SceneArgs::parsed() {
   requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
                     pixels * kRenderBytesPerPixel);
   if (!options.gbuffer.path.empty())
-    for (const char* option : {"--size", "--view", "--scene"})
+    for (const char* option : {"--view", "--scene"})
       if (app && app->count(option) > 0)
-        throw InputError(fmt::format("--gbuffer with {}: the G-buffer sets the image and each pixel's view", option));
+        throw InputError(fmt::format("--gbuffer with {}: the G-buffer sets each pixel's view", option));
   if (!options.mesh.path.empty() && app && app->count("--view") > 0)
     throw InputError("--mesh with --view: the camera (--camera-origin, --camera-target) sets each pixel's view");
   const SceneShape shape = parseSceneShape(options.shape);
@@ -101,7 +101,12 @@ SceneOptions SceneArgs::parsed() {
 
 Scene SceneArgs::make() {
   parsed();
+  const int askedWidth = options.width, askedHeight = options.height;
   Scene scene = makeScene(options);
+  if (!options.gbuffer.path.empty() && app && app->count("--size") > 0 &&
+      (scene.grid.width != askedWidth || scene.grid.height != askedHeight))
+    throw InputError(fmt::format("--size {}: the G-buffer {} is {}x{}", size, options.gbuffer.path, scene.grid.width,
+                                 scene.grid.height));
   if (scene.grid.spec == kGBufferBrdf && app && app->count("--grid") > 0)
     throw InputError(
         fmt::format("--grid with --gbuffer {}: the G-buffer holds each pixel's BRDF (its channels "
