@@ -1,6 +1,7 @@
 // The command line: bad input gets a clear message naming the problem, a non-zero
 // exit, and no output file; a good run writes its image and report.
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -50,8 +51,8 @@ TEST_CASE("render --scene spheres writes the background transparent black, and r
   auto out = dir.path / "s.exr", report = dir.path / "s.json";
   auto r =
       runMisalloc(fmt::format("render --scene spheres:2x2 --envmap cosk:1 --size 16x16 --spp 16 --device cpu "
-                              "--reference-spp 64 --out {} --report {} --cache-dir {}",
-                              out.string(), report.string(), (dir.path / "cache").string()));
+                              "--reference none --out {} --report {}",
+                              out.string(), report.string()));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   const misalloc::RgbImage image = misalloc::readExr(out.string());
@@ -69,7 +70,6 @@ TEST_CASE("render --scene spheres writes the background transparent black, and r
   CHECK(j["scene"]["covered_pixels"] == covered);
   CHECK(j["scene"]["view_deg"][0] == 75.0);
   CHECK(j["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
-  CHECK(j["reference"]["source"].get<std::string>().find("compensated:0.5") != std::string::npos);
 }
 
 TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
@@ -146,6 +146,8 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
   misalloc::RgbImage nan{4, 2, std::vector<float>(24, 1.0f)};
   nan.rgb[3 * (1 * 4 + 2) + 0] = std::numeric_limits<float>::quiet_NaN();  // x=2, y=1, R
   misalloc::test::writeRawExr(file("nan.exr"), nan);
+  REQUIRE(::mkfifo(file("fifo.exr").c_str(), 0600) == 0);  // would block an open() forever
+  fs::create_directories(file("folder.exr"));
   struct Case {
     std::string name, expected;
   };
@@ -155,11 +157,15 @@ TEST_CASE("bad envmap files fail clearly through the CLI and write nothing", "[c
                         {"cut.exr", "truncated or corrupt"},
                         {"rg.exr", "no B channel"},
                         {"zero.exr", "data window"},
-                        {"nan.exr", "1 NaN or infinite channel values, the first at x=2, y=1, channel R"}};
+                        {"nan.exr", "1 NaN or infinite channel values, the first at x=2, y=1, channel R"},
+                        {"fifo.exr", "is not a regular file"},
+                        {"folder.exr", "is not a regular file"}};
   auto out = dir.path / "r.exr", report = dir.path / "r.json";
   for (const Case& c : cases) {
+    // A run that blocks is killed: exit 124, not the 2 expected.
     auto r = runMisalloc(fmt::format("render --envmap {} --size 8x8 --spp 8 --reference none --out {} --report {}",
-                                     file(c.name), out.string(), report.string()));
+                                     file(c.name), out.string(), report.string()),
+                         "timeout 60");
     INFO(c.name << "\n" << r.output);
     CHECK(r.exitCode == 2);
     CHECK(r.output.find(file(c.name)) != std::string::npos);

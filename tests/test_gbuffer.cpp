@@ -266,7 +266,9 @@ TEST_CASE("bad G-buffers are refused naming the problem", "[gbuffer][safety]") {
                     Catch::Contains("several view layers (A1, B2)"));
 }
 
-TEST_CASE("render --gbuffer: one scene as Mitsuba and as misalloc write it renders the same image", "[gbuffer][cli]") {
+// [release-only]: its reading is the unit tests' above, which the sanitizers run.
+TEST_CASE("render --gbuffer: one scene as Mitsuba and as misalloc write it renders the same image",
+          "[gbuffer][cli][release-only]") {
   TempDir dir("gbuffer_cli");
   const TruthScene truth = truthScene();
   std::vector<std::string> images;
@@ -376,7 +378,8 @@ TEST_CASE("a G-buffer's BRDF channels give each pixel its BRDF, its UV channels 
   }
 }
 
-TEST_CASE("misalloc gbuffer writes a scene that render --gbuffer renders as the scene itself", "[gbuffer][cli]") {
+TEST_CASE("misalloc gbuffer writes a scene that render --gbuffer renders as the scene itself",
+          "[gbuffer][cli][release-only]") {
   TempDir dir("gbuffer_round_trip");
   const std::string gbuffer = (dir.path / "g.exr").string();
   auto r = runMisalloc(fmt::format("gbuffer --scene spheres:2x2 --size 24x20 --out {}", gbuffer));

@@ -21,7 +21,7 @@ const char* shardUnitName(ShardUnit unit);
 
 // The scenes (before their envmap pdfs) that `shard` runs, each with the repeats it runs
 // of them (CompareCase::repeats); the whole run for Shard{}. Throws InputError when the
-// shard would have no unit.
+// run has fewer units than shards, whichever shard asks: one of them would have none.
 std::vector<CompareCase> shardCases(const std::vector<CompareCase>& scenes, int repeats, ShardUnit unit, Shard shard);
 
 }  // namespace misalloc

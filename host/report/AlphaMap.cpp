@@ -21,6 +21,7 @@ AlphaMapFiles encodeAlphaMaps(const Scene& scene, const Rendering& rendering) {
   std::vector<uint8_t> rgb(size_t(W) * H * 3, 0);
   for (size_t p = 0; p < size_t(W) * H; ++p) {
     for (int k = 0; k < M; ++k) planes[k][p] = float(rendering.alpha[p * M + k]);
+    if (!rendering.image.covers(p)) continue;  // the background took no samples: black
     double envmap = rendering.alpha[p * M];
     rgb[3 * p + 0] = uint8_t(std::lround(255 * (1 - envmap)));
     rgb[3 * p + 2] = uint8_t(std::lround(255 * envmap));

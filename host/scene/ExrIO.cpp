@@ -40,6 +40,9 @@ TexelLocation locationOf(std::size_t valueIndex, int width) {
 void requireOpenExrFile(const std::string& path) {
   std::error_code ignored;
   if (!std::filesystem::exists(path, ignored)) throw InputError(fmt::format("'{}': no such file", path));
+  // A FIFO or a device would block the open, or never end.
+  if (!std::filesystem::is_regular_file(path, ignored))
+    throw InputError(fmt::format("'{}' is not a regular file", path));
   if (!Imf::isOpenExrFile(path.c_str()))
     throw InputError(fmt::format("'{}' is not an OpenEXR file (or cannot be read)", path));
 }

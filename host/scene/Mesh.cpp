@@ -31,8 +31,10 @@ Point mapPoint(GBufferConvention convention, const aiVector3D& v) {
 
 Triangles readTriangles(const std::string& path, GBufferConvention convention) {
   std::error_code ignored;
+  if (!std::filesystem::exists(path, ignored)) throw InputError(fmt::format("--mesh '{}': no such file", path));
+  // A FIFO or a device would block the read, or never end.
   if (!std::filesystem::is_regular_file(path, ignored))
-    throw InputError(fmt::format("--mesh '{}': no such file", path));
+    throw InputError(fmt::format("--mesh '{}' is not a regular file", path));
   Assimp::Importer importer;
   // Smooth normals where the file has none; every node's transform applied.
   const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
