@@ -2,6 +2,7 @@
 // sphere's pixels face the camera, each sphere of a grid has one BRDF, and pixels that see
 // no surface take no samples and count in no error, through every method's render.
 #include <fmt/format.h>
+#include <png.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -14,6 +15,7 @@
 #include "SceneFixtures.h"
 #include "render/Reference.h"
 #include "render/Render.h"
+#include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "scene/SceneShape.h"
 
@@ -41,6 +43,17 @@ MeanAndError coveredMean(const RgbImage& image) {
     if (image.covers(p))
       rgb.insert(rgb.end(), image.rgb.begin() + ptrdiff_t(3 * p), image.rgb.begin() + ptrdiff_t(3 * p + 3));
   return pixelMean(rgb);
+}
+
+// The RGB of an 8-bit PNG's bytes (libpng's simplified API), row 0 first.
+std::vector<uint8_t> decodePngRgb(const std::string& bytes) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  REQUIRE(png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()) != 0);
+  image.format = PNG_FORMAT_RGB;
+  std::vector<uint8_t> rgb(PNG_IMAGE_SIZE(image));
+  REQUIRE(png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr) != 0);
+  return rgb;
 }
 
 }  // namespace
@@ -173,6 +186,14 @@ TEST_CASE("background pixels take no samples and count in no error, whatever the
     CHECK(sampledBackground == 0);
     CHECK(nonZeroBackground == 0);
     CHECK(uncounted == 0);
+    // The α map's picture: red + blue = 255 where samples were split, black where none.
+    const std::vector<uint8_t> picture = decodePngRgb(encodeAlphaMaps(scene, r).png);
+    size_t misdrawn = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+      const int red = picture[3 * p], blue = picture[3 * p + 2];
+      misdrawn += scene.geometry.covered[p] ? std::abs(red + blue - 255) > 1 : red + blue != 0;
+    }
+    CHECK(misdrawn == 0);
     // The background's empty sums fall back in every rule; they are not reported.
     CHECK(r.fallbackPixels + r.flooredPixels + r.skippedPixels <= covered);
     CHECK(r.weightsFallbacks.pixels <= covered);
