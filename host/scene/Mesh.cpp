@@ -24,10 +24,13 @@ struct Triangles {
   std::vector<Point> positions, normals;  // three per triangle
 };
 
-Point mapPoint(GBufferConvention convention, const aiVector3D& v) {
-  const Vec3d m = toMapFrame(convention, {v.x, v.y, v.z});
+// A point or direction of the convention's world in the map's frame.
+Point mapPoint(GBufferConvention convention, const Point& v) {
+  const Vec3d m = toMapFrame(convention, {v.x(), v.y(), v.z()});
   return Point(m[0], m[1], m[2]);
 }
+
+Point toPoint(const aiVector3D& v) { return Point(v.x, v.y, v.z); }
 
 Triangles readTriangles(const std::string& path, GBufferConvention convention) {
   std::error_code ignored;
@@ -48,8 +51,8 @@ Triangles readTriangles(const std::string& path, GBufferConvention convention) {
       const aiFace& face = mesh->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
       for (unsigned k = 0; k < 3; ++k) {
-        t.positions.push_back(mapPoint(convention, mesh->mVertices[face.mIndices[k]]));
-        t.normals.push_back(mapPoint(convention, mesh->mNormals[face.mIndices[k]]));
+        t.positions.push_back(mapPoint(convention, toPoint(mesh->mVertices[face.mIndices[k]])));
+        t.normals.push_back(mapPoint(convention, toPoint(mesh->mNormals[face.mIndices[k]])));
       }
     }
   }
@@ -122,13 +125,9 @@ GBufferImage rasteriseMesh(const MeshOptions& mesh, const GBufferOptions& gbuffe
   const GBufferConvention convention = parseGBufferConvention(gbuffer.convention);
   if (gbuffer.cameraOrigin.empty())
     throw InputError(fmt::format("--mesh {}: the camera needs --camera-origin X,Y,Z", mesh.path));
-  auto inMap = [&](const Point& p) {
-    const Vec3d m = toMapFrame(convention, {p.x(), p.y(), p.z()});
-    return Point(m[0], m[1], m[2]);
-  };
-  const PinholeCamera camera =
-      pinholeCamera(inMap(parsePoint("--camera-origin", gbuffer.cameraOrigin)),
-                    inMap(parsePoint("--camera-target", mesh.target)), mesh.verticalFovDegrees, width, height);
+  const PinholeCamera camera = pinholeCamera(mapPoint(convention, parsePoint("--camera-origin", gbuffer.cameraOrigin)),
+                                             mapPoint(convention, parsePoint("--camera-target", mesh.target)),
+                                             mesh.verticalFovDegrees, width, height);
   const Triangles triangles = readTriangles(mesh.path, convention);
 
   // Each triangle tried at the pixels its projection covers (all of them where a corner
