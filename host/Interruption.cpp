@@ -51,6 +51,16 @@ void exitOnInterrupt() {
   for (int signal : {SIGINT, SIGTERM}) sigaction(signal, &action, nullptr);
 }
 
+namespace {
+std::function<void()> interruptionCheck;
+}  // namespace
+
+void setInterruptionCheck(std::function<void()> check) { interruptionCheck = std::move(check); }
+
+void checkInterruption() {
+  if (interruptionCheck) interruptionCheck();
+}
+
 CriticalSection::CriticalSection() { openSections.fetch_add(1); }
 
 CriticalSection::~CriticalSection() {

@@ -5,6 +5,8 @@
 // place (exitOnInterrupt, CriticalSection).
 #include <signal.h>
 
+#include <functional>
+
 namespace misalloc {
 
 // While alive, SIGINT and SIGTERM are blocked in this thread and in every thread
@@ -35,6 +37,13 @@ class InterruptionGuard {
 // old or all of them new. SIGKILL cannot be caught: what it leaves behind is hidden
 // temporaries, which the next run that writes there removes (AtomicFile.h).
 void exitOnInterrupt();
+
+// A library caller's own way to stop a run: the Python module's, whose Ctrl-C must raise
+// KeyboardInterrupt and leave the interpreter usable, not end it. `check` is called
+// between kernel launches (the stages of a render, the batches of a reference) and
+// throws to stop the run there. None by default: the CLI's signals end the process.
+void setInterruptionCheck(std::function<void()> check);
+void checkInterruption();
 
 class CriticalSection {
  public:

@@ -12,6 +12,7 @@
 
 #include "Error.h"
 #include "cl/Device.h"
+#include "cli/CommandLine.h"
 #include "cli/Subcommand.h"
 
 using namespace misalloc;
@@ -27,26 +28,12 @@ void refuseUnknownSubcommand(const CLI::App& app, int argc, char** argv) {
     throw InputError(fmt::format("unknown subcommand '{}'; the subcommands are {}", argv[1], fmt::join(names, ", ")));
 }
 
-// An option given an empty value ("--out ''") names nothing: a path, a list, a name. Refused
-// here, before any work, for every option of every subcommand; leaving an option out
-// is how a default is asked for.
-void refuseEmptyValues(const CLI::App& command) {
-  for (const CLI::Option* option : command.get_options()) {
-    const std::vector<std::string>& values = option->results();
-    if (std::find(values.begin(), values.end(), std::string()) != values.end())
-      throw InputError(fmt::format("{}: an empty value{}", option->get_name(),
-                                   option->get_required() ? "" : "; leave the option out for its default"));
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"misalloc: per-pixel allocation of MIS samples for envmap x BRDF direct lighting"};
   app.require_subcommand(1);
-  // A repeated option takes its last value, as in most command-line tools. Set before
-  // the subcommands are added: they copy it.
-  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  setParsingRules(app);
   const std::vector<Subcommand> subcommands{addDevicesCommand(app), addRenderCommand(app), addReferenceCommand(app),
                                             addCompareCommand(app), addPaperCommand(app),  addMergeCommand(app),
                                             addGBufferCommand(app)};

@@ -130,20 +130,25 @@ std::vector<Device> openSubDevices(const std::string& spec, int count) {
   std::vector<cl::Device> members = parts;
   members.push_back(whole.device);
   const cl::Context shared(members);
-  auto wholeInShared = std::make_shared<Device>(
-      Device{whole.platform, whole.device, shared, cl::CommandQueue(shared, whole.device, CL_QUEUE_PROFILING_ENABLE),
-             "", nullptr});
+  auto wholeInShared =
+      std::make_shared<Device>(Device{whole.platform, whole.device, shared,
+                                      cl::CommandQueue(shared, whole.device, CL_QUEUE_PROFILING_ENABLE), "", nullptr});
   std::vector<Device> devices;
   for (int i = 0; i < count; ++i) {
-    Device part{whole.platform, parts[size_t(i)], shared,
+    Device part{whole.platform,
+                parts[size_t(i)],
+                shared,
                 cl::CommandQueue(shared, parts[size_t(i)], CL_QUEUE_PROFILING_ENABLE),
-                fmt::format("sub-device {}/{}", i + 1, count), wholeInShared};
+                fmt::format("sub-device {}/{}", i + 1, count),
+                wholeInShared};
     devices.push_back(std::move(part));
   }
   return devices;
 }
 
 cl::Program buildProgram(const Device& device, const std::string& mainFile, const std::string& options) {
+  const std::string key = mainFile + " " + options;
+  if (auto built = device.programs->find(key); built != device.programs->end()) return built->second;
   cl::Program program(device.context, kernelSource(mainFile));
   try {
     program.build({device.device}, options.c_str());
@@ -151,6 +156,7 @@ cl::Program buildProgram(const Device& device, const std::string& mainFile, cons
     throw DeviceError(fmt::format("building kernels/{} for {} failed with options '{}'. Build log:\n{}", mainFile,
                                   device.name(), options, program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device.device)));
   }
+  device.programs->emplace(key, program);
   return program;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 #include <CL/opencl.hpp>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -19,6 +20,9 @@ struct Device {
   std::string part;  // a sub-device's place in its device, e.g. "sub-device 1/2"; else empty
   // A sub-device's whole device, in the same context; else null.
   std::shared_ptr<const Device> whole;
+  // The programs built for it, by kernel file and options (buildProgram): a run that
+  // builds many samplers (compare, the Python module's renders) builds each variant once.
+  std::shared_ptr<std::map<std::string, cl::Program>> programs = std::make_shared<std::map<std::string, cl::Program>>();
 
   std::string name() const;
 };
@@ -52,8 +56,8 @@ std::string mebibytes(uint64_t bytes);
 // `pixels` pixels) and the device's limits; any other error by its code.
 DeviceError explainBufferError(const cl::Error& e, const Device& device, const std::string& cause, int pixels);
 
-// Builds `mainFile` (an embedded kernel source) with `options`; a failure throws
-// DeviceError carrying the build log.
+// Builds `mainFile` (an embedded kernel source) with `options`, once per device; a
+// failure throws DeviceError carrying the build log.
 cl::Program buildProgram(const Device& device, const std::string& mainFile, const std::string& options);
 
 }  // namespace misalloc

@@ -30,10 +30,15 @@ class DeviceArgs {
   std::unique_ptr<StageSampler> makeSampler(const Scene& scene, const SamplerConfig& config, int localSize);
   // The name a report gives the devices.
   std::string name() const;
+  // The devices, opened at the first sampler; a caller that renders again with the same
+  // --device (the Python module's scene) hands them to the next DeviceArgs with `reuse`,
+  // sharing their contexts and built programs.
+  std::shared_ptr<SamplerDevices> devices();
+  void reuse(std::shared_ptr<SamplerDevices> devices);
 
  private:
   std::string spec_ = "auto";
-  std::unique_ptr<SamplerDevices> devices_;
+  std::shared_ptr<SamplerDevices> devices_;
 };
 
 }  // namespace misalloc

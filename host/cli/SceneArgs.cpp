@@ -15,6 +15,7 @@ namespace misalloc {
 
 void SceneArgs::add(CLI::App& command) {
   app = &command;
+  const size_t firstSceneOption = command.get_options().size();
   command
       .add_option("--envmap", options.envmap,
                   "EXR path, shipped map name (forest_slope, rooitou_park, ...), constant[:R], cosk:K or "
@@ -61,6 +62,8 @@ void SceneArgs::add(CLI::App& command) {
   command.add_option("--procedural-width", options.proceduralWidth, "texel width of procedural envmaps")
       ->capture_default_str()
       ->check(integerIn(2, 16384));
+  const auto options = command.get_options();
+  for (size_t i = firstSceneOption; i < options.size(); ++i) options[i]->group("Scene");
 }
 
 void SceneArgs::addEnvmapPdf(CLI::App& command) {

@@ -13,6 +13,7 @@
 #include "ContentHash.h"
 #include "Error.h"
 #include "FileLock.h"
+#include "Interruption.h"
 #include "render/Method.h"
 
 namespace misalloc {
@@ -72,6 +73,7 @@ SampledReference sampleReference(StageSampler& sampler, const Scene& scene, int 
     StagePlan plan = singleStagePlan(scene, Method::Equal, n);
     plan.firstIndex = taken;  // each batch takes samples of its own: independent estimates
     for (size_t i = 0; i < taken.size(); ++i) taken[i] += uint32_t(plan.counts[i]);
+    checkInterruption();
     StageResult batch = sampler.run(plan, seed);
     for (size_t i = 0; i < sum.size(); ++i) {
       sum[i] += double(n) * batch.rgb[i];

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "Error.h"
+#include "Interruption.h"
 #include "KernelCode.h"
 #include "alloc/Apportion.h"
 #include "alloc/GridSearchAllocator.h"
@@ -111,6 +112,7 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
     work = sampler.launchWork(stage.plan);
     timing.predictedKernelSeconds = costs->predict(work);
   }
+  checkInterruption();
   stage.result = sampler.run(stage.plan, seed);
   timing.kernelSeconds = stage.result.kernelSeconds;
   if (predicts) costs->observe(work, stage.result.kernelSeconds);

@@ -266,4 +266,14 @@ Envmap makeEnvmap(const std::string& spec, int proceduralWidth, ReadWarnings* wa
   return map;
 }
 
+Envmap envmapFromTexels(RgbImage texels, const std::string& name, ReadWarnings* warnings) {
+  Envmap map;
+  map.image = std::move(texels);
+  map.image.alpha = {};
+  checkImageValues(map.image, name, warnings);
+  refuseOverflowingRadiance(map.image, name);
+  map.description = fmt::format("{} ({}×{})", name, map.image.width, map.image.height);
+  return map;
+}
+
 }  // namespace misalloc

@@ -33,4 +33,9 @@ struct Envmap {
 // average of the radiance over the texel. Throws InputError for a bad spec or file.
 Envmap makeEnvmap(const std::string& spec, int proceduralWidth = 512, ReadWarnings* warnings = nullptr);
 
+// A map given as texels in the layout above (the Python module's array), checked as a
+// file's are (checkImageValues; radiance that would overflow float refused); `name`
+// stands for it in messages and reports.
+Envmap envmapFromTexels(RgbImage texels, const std::string& name, ReadWarnings* warnings = nullptr);
+
 }  // namespace misalloc

@@ -218,9 +218,13 @@ RgbImage readExr(const std::string& path, ReadWarnings* warnings, ExrAttributes*
   } catch (const std::exception& e) {  // Iex::BaseExc for truncated or corrupt files
     throw InputError(fmt::format("cannot read '{}' (truncated or corrupt?): {}", path, e.what()));
   }
-  rejectNonFinite(image, path);
-  zeroNegatives(image, warnings);
+  checkImageValues(image, path, warnings);
   return image;
+}
+
+void checkImageValues(RgbImage& image, const std::string& source, ReadWarnings* warnings) {
+  rejectNonFinite(image, source);
+  zeroNegatives(image, warnings);
 }
 
 std::string encodeExr(const RgbImage& image, const ExrAttributes& attributes) {

@@ -48,6 +48,11 @@ using ExrAttributes = std::map<std::string, std::string>;
 // values. `attributes`, if given, receives the header's string attributes.
 RgbImage readExr(const std::string& path, ReadWarnings* warnings = nullptr, ExrAttributes* attributes = nullptr);
 
+// What readExr checks of every image it reads, for images given in memory (the Python
+// module's arrays): throws InputError naming `source` for NaN or infinite values, or an
+// alpha outside [0, 1], and sets negative values to 0, counting them in `warnings`.
+void checkImageValues(RgbImage& image, const std::string& source, ReadWarnings* warnings = nullptr);
+
 // The bytes of an OpenEXR file of float R, G, B (and A with coverage) with ZIP compression, with `attributes`
 // in its header. Both encoders refuse (std::runtime_error) values that are NaN or
 // infinite: a written image is always finite.

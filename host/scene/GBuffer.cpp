@@ -75,6 +75,13 @@ void requireChannels(const ExrHeader& header, const std::vector<std::string>& na
 
 const std::vector<std::string> kBrdfChannels{"rho_d", "rho_s", "phong_n"};
 
+// The planes `names` of a G-buffer in memory, whose header lists them (requireChannels).
+std::vector<std::vector<float>> planesOf(const ChannelImage& image, const std::vector<std::string>& names) {
+  std::vector<std::vector<float>> planes;
+  for (const std::string& n : names) planes.push_back(image.planes.at(n));
+  return planes;
+}
+
 bool hasChannel(const ExrHeader& header, const std::string& name) {
   return std::find(header.channels.begin(), header.channels.end(), name) != header.channels.end();
 }
@@ -186,7 +193,7 @@ Vec3d toMapFrame(GBufferConvention convention, const Vec3d& d) {
 
 GBufferImage readGBuffer(const GBufferOptions& options) {
   const GBufferConvention convention = parseGBufferConvention(options.convention);
-  const ExrHeader header = readExrHeader(options.path);
+  const ExrHeader header = options.channels ? options.channels->header : readExrHeader(options.path);
   const ChannelPrefixes prefixes = channelPrefixes(convention, options, header);
   const std::vector<std::string> normalNames = xyz(prefixes.normal), viewNames = xyz("view");
   const bool hasView =
@@ -205,7 +212,8 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   if (hasBrdf) names.insert(names.end(), kBrdfChannels.begin(), kBrdfChannels.end());
   const size_t uvPlane = names.size();
   names.insert(names.end(), uvNames.begin(), uvNames.end());
-  const std::vector<std::vector<float>> planes = readExrChannels(options.path, names);
+  const std::vector<std::vector<float>> planes =
+      options.channels ? planesOf(*options.channels, names) : readExrChannels(options.path, names);
 
   GBufferImage out;
   out.width = header.width;

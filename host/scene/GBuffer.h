@@ -4,9 +4,12 @@
 // u = atan2(y, x)/2π) by the convention that also orients the renderer's lat-long map, so
 // that a G-buffer and a map exported from one renderer are lit as that renderer lights them.
 #include <array>
+#include <map>
+#include <memory>
 #include <string>
 
 #include "scene/BrdfGrid.h"
+#include "scene/ExrIO.h"
 #include "scene/SceneGeometry.h"
 
 namespace misalloc {
@@ -25,8 +28,15 @@ using Vec3d = std::array<double, 3>;
 // (x, y, z) → (−x, y, z). pbrt-v4 (imgtool makeequiarea) and misalloc: the identity.
 Vec3d toMapFrame(GBufferConvention convention, const Vec3d& d);
 
+// A G-buffer given in memory (the Python module's arrays): what a file's header would say
+// (size, channel names, matrices) and one plane per channel, row 0 first.
+struct ChannelImage {
+  ExrHeader header;
+  std::map<std::string, std::vector<float>> planes;
+};
+
 struct GBufferOptions {
-  std::string path;  // empty: no G-buffer
+  std::string path;  // empty: no G-buffer; with `channels`, only their name in messages
   std::string convention = "misalloc";
   // Channel prefixes of .X, .Y, .Z; empty: the convention's (misalloc N, P; Mitsuba
   // sh_normal, position; Blender <ViewLayer>.Normal, <ViewLayer>.Position; pbrt Ns, P).
@@ -38,6 +48,7 @@ struct GBufferOptions {
   // scene says `coordinatesystem "world"`; its header's worldToCamera takes the frames to
   // the world. The others write world space.
   std::string space;
+  std::shared_ptr<const ChannelImage> channels;  // the G-buffer in memory instead of the file at `path`
 };
 
 struct GBufferImage {

@@ -141,7 +141,7 @@ GBufferImage rasteriseMesh(const MeshOptions& mesh, const GBufferOptions& gbuffe
     double x0 = width, x1 = -1, y0 = height, y1 = -1;
     bool projected = true;
     for (int k = 0; k < 3; ++k) {
-      double x, y;
+      double x = 0, y = 0;
       projected = projected && camera.project(corner[k], x, y);
       x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
     }

@@ -121,9 +121,13 @@ Scene makeScene(const SceneOptions& options) {
     scene.grid = makeBrdfGrid(options.grid, options.width, options.height, shape.uv);
     scene.geometry = std::move(shape.geometry);
   }
-  std::string resolved = resolveEnvmapSpec(options.envmap);
-  if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
-  scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
+  if (options.envmapTexels) {
+    scene.envmap = envmapFromTexels(*options.envmapTexels, options.envmap, &scene.envmapWarnings);
+  } else {
+    std::string resolved = resolveEnvmapSpec(options.envmap);
+    if (resolved != options.envmap || fs::exists(resolved)) scene.envmapPath = resolved;
+    scene.envmap = makeEnvmap(resolved, options.proceduralWidth, &scene.envmapWarnings);
+  }
   if (options.envmapPdf.optimal()) {
     // q = (1−C) p_ρ of [Kar19] eq. 9 takes the BRDF as one technique; split into lobes,
     // q would depend on the lobes' shares too.

@@ -1,5 +1,6 @@
 #pragma once
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct SceneOptions {
   // Where the optimal pdf's tables are cached (distributions/BankCache.h); empty: built
   // every time. Not part of the scene: the same tables either way.
   std::string bankCacheDir;
+  // The map's texels given in memory (the Python module's array); `envmap` then only
+  // names it.
+  std::shared_ptr<const RgbImage> envmapTexels;
 
   // M: envmap sampling and BRDF sampling, then either of the BRDF's lobes split, or the
   // product technique.
