@@ -123,7 +123,9 @@ int runCompare(CompareArgs& args) {
     // Every shard knows the whole run's cases, in order, for the merge; the merge
     // checks the unit itself, to name it when shards of two units meet.
     shard.emplace();
-    shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"});
+    std::vector<SceneOptions> scenes;
+    for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
+    shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"}, scenes);
     shard->shard = parseShard(args.shard, "--shard");
     shard->unit = unit;
     for (const CompareCase& c : variants(compare.cases)) shard->manifest.push_back(c.label);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <climits>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -44,7 +45,7 @@ struct RenderArgs {
   bool noPreview = false;
   std::string method = "exact", estimator = "multi", weights = "balance", out = "render.exr", report = "render.json",
               reference = "auto", cacheDir = defaultCacheDir(), alphaMap, shard;
-  std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
+  std::function<std::string()> run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
 
 // A band of a sharded render writes its rows only: no preview, no α map.
@@ -135,7 +136,7 @@ int runRender(RenderArgs& args) {
     report["band"] = {{"shard", args.shard},
                       {"rows", {band->rows.begin, band->rows.end}},
                       {"rendered_rows", {band->rendered.begin, band->rendered.end}}};
-    outputs.put(args.out, encodeBand(r.image, {args.run, *band, width, height, nodeName(), report}));
+    outputs.put(args.out, encodeBand(r.image, {args.run(), *band, width, height, nodeName(), report}));
   } else {
     outputs.put(args.out, encodeExr(r.image));
   }
@@ -206,8 +207,13 @@ Subcommand addRenderCommand(CLI::App& app) {
   command->add_option("--shard", args->shard,
                       "K/N: render band K of N (whole rows of 16-pixel blocks) into --out, for `misalloc merge`");
   return {command, [args, command] {
-            args->run = runIdentity(*command, {"--shard", "--out", "--report", "--no-preview", "--cache-dir",
-                                               "--reference", "--reference-spp", "--help"});
+            // Once runRender has resolved the scene's options and read its inputs.
+            args->run = [command, scene = &args->scene] {
+              return runIdentity(*command,
+                                 {"--shard", "--out", "--report", "--no-preview", "--cache-dir", "--reference",
+                                  "--reference-spp", "--help"},
+                                 {scene->options});
+            };
             return runRender(*args);
           }};
 }

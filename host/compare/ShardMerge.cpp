@@ -21,8 +21,8 @@ void requireOneRun(const std::vector<std::string>& folders, const std::vector<Sh
   for (size_t i = 0; i < records.size(); ++i) {
     const ShardRecord& r = records[i];
     if (r.run != first.run)
-      throw InputError(fmt::format("{} and {} are shards of different runs: '{}' and '{}'", folders.front(), folders[i],
-                                   first.run, r.run));
+      throw InputError(fmt::format("{} and {} are shards of different runs: {}", folders.front(), folders[i],
+                                   runDifference(first.run, r.run)));
     if (r.shard.count != first.shard.count)
       throw InputError(fmt::format("{} and {} split the run into {} and {} shards", folders.front(), folders[i],
                                    first.shard.count, r.shard.count));
