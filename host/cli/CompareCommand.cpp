@@ -25,6 +25,7 @@
 #include "compare/CompareReport.h"
 #include "compare/Comparison.h"
 #include "compare/EnvmapPdfComparison.h"
+#include "compare/ShardFiles.h"
 #include "compare/ShardRecord.h"
 #include "compare/ShardUnit.h"
 #include "compare/Suite.h"
@@ -158,6 +159,7 @@ int runCompare(CompareArgs& args) {
     shard->repeats = compare.repeats;
     shard->tableBudget = compare.tableBudget;
     shard->comparison = comparison;
+    shard->files = shardFileChecksums(compare.outDir);
     writeFileAtomically(compare.outDir + "/" + kShardRecordFile, shardRecordJson(*shard));
     outputs.commit();
     std::cout << fmt::format("shard {}: {} case(s), {} run(s) in {}; merge the shards with misalloc merge --out-dir\n",
