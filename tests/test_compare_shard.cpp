@@ -205,6 +205,10 @@ TEST_CASE("merge reads every run and file of the shards before it writes any, na
                  {merge + emptied + " " + s1, (fs::path(emptied) / png).string() + ": its bytes differ"},
                  {merge + stray + " " + s1, (fs::path(stray) / "notes.txt").string() + ": a file the shard did not"},
                  {merge + lostRuns + " " + s1, lostRuns + "/shard.json: holds 0 runs of"},
-                 {merge + fifo + " " + s1, fifo + "/shard.json: not a regular file"}},
+                 {merge + fifo + " " + s1, fifo + "/shard.json: not a regular file"},
+                 // An output inside a shard, or in its place: refused before any work.
+                 {fmt::format("merge --out-dir {}/m {} {}", s0, s0, s1), "lies inside a shard"},
+                 {fmt::format("merge --out-dir {} {} {}", s1, s0, s1), "never replaces an input"}},
                 dir.path / "m");
+  CHECK_FALSE(fs::exists(fs::path(s0) / "m"));
 }
