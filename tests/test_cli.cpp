@@ -108,6 +108,9 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--scene sphere --view 200", "--view 200"},
       {"--scene sphere --envmap-pdf optimal", "--envmap-pdf optimal with per-pixel normals or views: not implemented"},
       {"--scene sphere --product", "--product with per-pixel normals or views: not implemented"},
+      {"--product --method envmap", "--product with --method envmap: envmap samples the envmap alone"},
+      {"--product --method brdf", "--product with --method brdf: brdf samples the BRDF alone"},
+      {"--product --method ris --envmap-pdf plain", "--product with --method ris"},
   };
   for (const Case& c : cases) {
     auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 {} {}", outputs, c.args));

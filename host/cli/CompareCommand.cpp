@@ -33,6 +33,7 @@
 #include "compare/SummaryTables.h"
 #include "compare/WeightsComparison.h"
 #include "render/Reference.h"
+#include "render/RunChecks.h"
 
 namespace misalloc {
 namespace {
@@ -104,6 +105,11 @@ int runCompare(CompareArgs& args) {
   const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
   compare.methods = parseMethodList(args.methods);
+  // envmap, brdf and ris never sample the product technique: with --product, "all" is the others.
+  if (args.methods == "all" && compare.cases.front().scene.product)
+    compare.methods.erase(std::remove_if(compare.methods.begin(), compare.methods.end(),
+                                         [](Method m) { return !takesProductTechnique(m); }),
+                          compare.methods.end());
   compare.budgets = parseBudgets(args.budgets);
   // Every scene with every pdf and then every weights; methods refused with the default
   // pdfs or with optimal weights are left out of those cases alone, saying why.
