@@ -212,3 +212,36 @@ TEST_CASE("merge reads every run and file of the shards before it writes any, na
                 dir.path / "m");
   CHECK_FALSE(fs::exists(fs::path(s0) / "m"));
 }
+
+TEST_CASE("merge takes shards that spell the run's options differently, and refuses shards of another map's texels",
+          "[compare][shard][cli][safety]") {
+  TempDir dir("compare_shard_identity");
+  // One name in three folders: `a` and `same` hold the same map, `other` another.
+  for (const char* folder : {"a", "same", "other"}) {
+    fs::create_directories(dir.path / folder);
+    const float radiance = folder == std::string("other") ? 0.75f : 0.5f;
+    misalloc::writeExr((dir.path / folder / "map.exr").string(),
+                       misalloc::RgbImage{8, 4, std::vector<float>(96, radiance)});
+  }
+  // Shard k of 2, by repeat, from `folder`, into dir/`name`.
+  auto shard = [&](const std::string& folder, int k, const std::string& spelled, const std::string& name) {
+    auto r = runMisalloc(
+        fmt::format("compare --envmap map.exr --repeats 2 --size 8x8 --cost 1,1.5 --reference-spp 64 --device cpu "
+                    "--cache-dir {} --shard-unit repeat --shard {}/2 --out-dir {} {}",
+                    (dir.path / "cache").string(), k, (dir.path / name).string(), spelled),
+        fmt::format("cd {} &&", (dir.path / folder).string()));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    return (dir.path / name).string();
+  };
+  const std::string s0 = shard("a", 0, "--methods equal,exact --budgets 16 --envmap-pdfs plain", "s0");
+  const std::string s1 =
+      shard("same", 1, "--methods equal,exact --budgets 16.0 --envmap-pdfs plain --weights balance --seed 1", "s1");
+  const std::string other = shard("other", 1, "--methods equal,exact --budgets 16 --envmap-pdfs plain", "other1");
+  auto m = runMisalloc(fmt::format("merge --out-dir {} {} {}", (dir.path / "merged").string(), s0, s1));
+  INFO(m.output);
+  CHECK(m.exitCode == 0);
+  checkRefusals(dir.path,
+                {{fmt::format("merge --out-dir {} {} {}", (dir.path / "m").string(), s0, other), "envmap texels"}},
+                dir.path / "m");
+}

@@ -73,6 +73,21 @@ std::vector<int> parseBudgets(const std::string& list) {
   return budgets;
 }
 
+// The lists as parsed, in one spelling, written back to their options' variables, which
+// a shard's run identity reads (cli/RunIdentity.h): `--methods all` and the list of its
+// methods, `--budgets 16.0` and `16`, are one run.
+void writeBackLists(CompareArgs& args, const CompareOptions& compare, const std::vector<EnvmapPdf>& pdfs,
+                    const std::vector<MisWeights>& weights) {
+  std::vector<std::string> methods, pdfNames, weightNames;
+  for (Method m : compare.methods) methods.push_back(methodName(m));
+  for (const EnvmapPdf& pdf : pdfs) pdfNames.push_back(envmapPdfName(pdf));
+  for (MisWeights w : weights) weightNames.push_back(misWeightsName(w));
+  args.methods = fmt::format("{}", fmt::join(methods, ","));
+  args.budgets = fmt::format("{}", fmt::join(compare.budgets, ","));
+  args.envmapPdfs = fmt::format("{}", fmt::join(pdfNames, ","));
+  args.weights = fmt::format("{}", fmt::join(weightNames, ","));
+}
+
 int runCompare(CompareArgs& args) {
   InterruptionGuard guard;  // first: every thread started from here on inherits its mask
   CompareOptions& compare = args.compare;
@@ -130,6 +145,7 @@ int runCompare(CompareArgs& args) {
     // Every shard knows the whole run's cases, in order, for the merge; the merge
     // checks the unit itself, to name it when shards of two units meet.
     shard.emplace();
+    writeBackLists(args, compare, pdfs, weights);
     std::vector<SceneOptions> scenes;
     for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
     shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"}, scenes);
