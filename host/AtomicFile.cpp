@@ -8,12 +8,14 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
 #include <set>
 
+#include "ContentHash.h"
 #include "Error.h"
 #include "Interruption.h"
 
@@ -43,22 +45,40 @@ bool allDigits(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// The PID in a temporary's name, ".NAME.tmp-PID-ATTEMPT" (temporaryName), or -1.
+// The PID in the name of a temporary of this host (temporaryName: ".NAME.tmp-HOST-PID-
+// ATTEMPT"), or -1 for a name of another host, or of no temporary.
 long temporaryOwner(const std::string& name) {
   const size_t tag = name.rfind(".tmp-");
   if (name.empty() || name[0] != '.' || tag == std::string::npos || tag == 0) return -1;
-  const std::string rest = name.substr(tag + 5);
-  const size_t dash = rest.find('-');
-  if (dash == std::string::npos || !allDigits(rest.substr(0, dash)) || !allDigits(rest.substr(dash + 1))) return -1;
-  return dash > 9 ? -1 : std::stol(rest.substr(0, dash));
+  const std::string rest = name.substr(tag + 5), host = hostTag() + "-";
+  if (rest.compare(0, host.size(), host) != 0) return -1;
+  const std::string pidAndAttempt = rest.substr(host.size());
+  const size_t dash = pidAndAttempt.find('-');
+  if (dash == std::string::npos || !allDigits(pidAndAttempt.substr(0, dash)) ||
+      !allDigits(pidAndAttempt.substr(dash + 1)))
+    return -1;
+  return dash > 9 ? -1 : std::stol(pidAndAttempt.substr(0, dash));
 }
 
 }  // namespace
 
+const std::string& hostTag() {
+  static const std::string tag = [] {
+    char host[HOST_NAME_MAX + 1] = {};
+    ::gethostname(host, sizeof host - 1);
+    std::error_code ec;
+    ContentHash h;
+    h.add(std::string(host));
+    h.add(fs::read_symlink("/proc/self/ns/pid", ec).string());  // "pid:[INODE]": the namespace
+    return fmt::format("{:012x}", h.h >> 16);
+  }();
+  return tag;
+}
+
 std::string temporaryName(const std::string& path, int attempt) {
   const fs::path p(path);
   const std::string name = p.filename().string();
-  const std::string suffix = fmt::format(".tmp-{}-{}", ::getpid(), attempt);
+  const std::string suffix = fmt::format(".tmp-{}-{}-{}", hostTag(), ::getpid(), attempt);
   const size_t limit = nameLimit(p.parent_path());
   std::string stem = name;
   if (1 + stem.size() + suffix.size() > limit) {

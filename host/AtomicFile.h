@@ -10,13 +10,19 @@ namespace misalloc {
 // (temporaryName).
 std::string writeTemporaryBeside(const std::string& path, const std::string& content);
 
+// This process's host and PID namespace, as 12 hex digits: a PID names a process only
+// there. Temporaries carry it in their names, so that on a file system several machines
+// (or containers) share, none is taken for a dead run's by a run elsewhere.
+const std::string& hostTag();
+
 // A hidden name beside `path` for a temporary file or folder of this process, unique
-// with `attempt`: ".NAME.tmp-PID-ATTEMPT", NAME shortened (and a hash of it added)
-// where the whole would not fit the file system's limit.
+// with `attempt`: ".NAME.tmp-HOST-PID-ATTEMPT" (HOST: hostTag), NAME shortened (and a
+// hash of it added) where the whole would not fit the file system's limit.
 std::string temporaryName(const std::string& path, int attempt);
 
-// Removes what killed runs left in `folder`: temporary files and folders of this user
-// whose process (the PID in their name) no longer runs. Once per folder and process.
+// Removes what killed runs left in `folder`: temporary files and folders of this user,
+// host and PID namespace whose process (the PID in their name) no longer runs; those
+// of other hosts are left to them. Once per folder and process.
 void removeStaleTemporaries(const std::string& folder);
 
 // Renames `temporary` over `path`; on failure removes `temporary` and throws

@@ -75,10 +75,17 @@ OutputSet::~OutputSet() {
 }
 
 void OutputSet::refuseClashes(const NamedFile& output) const {
-  for (const NamedFile& input : inputs_)
+  std::error_code ec;
+  for (const NamedFile& input : inputs_) {
     if (sameFile(output.path, input.path))
       throw InputError(fmt::format("{} {} is the same file as {} {}: an output never replaces an input", output.option,
                                    output.path, input.option, input.path));
+    // An input read as a folder (a shard) reads what lies inside it: an output there
+    // would change it, or be copied into itself.
+    if (fs::is_directory(input.path, ec) && insideFolder(output.path, resolved(input.path)))
+      throw InputError(fmt::format("{} {} lies inside {} {}: an output never replaces an input; choose another place",
+                                   output.option, output.path, input.option, input.path));
+  }
   for (const NamedFile& other : outputs_)
     if (sameFile(output.path, other.path))
       throw InputError(fmt::format("{} {} and {} {} are the same file: each output needs a file of its own",
@@ -87,9 +94,10 @@ void OutputSet::refuseClashes(const NamedFile& output) const {
 
 void OutputSet::refuseInputInFolder(const NamedFile& input) const {
   if (!folder_.empty() && insideFolder(input.path, folder_))
-    throw InputError(fmt::format("{} {} lies inside {} {}, which the run replaces as a whole: an output never "
-                                 "replaces an input; choose another folder",
-                                 input.option, input.path, folderOption_, folder_));
+    throw InputError(
+        fmt::format("{} {} lies inside {} {}, which the run replaces as a whole: an output never "
+                    "replaces an input; choose another folder",
+                    input.option, input.path, folderOption_, folder_));
 }
 
 void OutputSet::claim(const std::string& option, const std::string& path) {
@@ -115,9 +123,11 @@ std::string OutputSet::claimFolder(const std::string& option, const std::string&
   if (fs::exists(target, ec) && !fs::is_directory(target, ec))
     throw InputError(fmt::format("{} {}: is a file, not a folder", option, folder));
   if (fs::is_directory(target, ec) && !fs::is_empty(target, ec) && !fs::exists(target / marker, ec))
-    throw InputError(fmt::format("{} {}: holds files that no earlier run of this command wrote (no {}); the run "
-                                 "replaces the folder as a whole: give a new or empty folder",
-                                 option, folder, marker));
+    throw InputError(
+        fmt::format("{} {}: holds files that no earlier run of this command wrote (no {}); the run "
+                    "replaces the folder as a whole: give a new or empty folder",
+                    option, folder, marker));
+  refuseClashes({option, folder});
   folderOption_ = option;
   folder_ = target.string();
   for (const NamedFile& input : inputs_) refuseInputInFolder(input);

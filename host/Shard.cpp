@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <optional>
+#include <vector>
 
 #include "Error.h"
 
@@ -15,7 +17,27 @@ std::optional<int> digitsValue(const std::string& text) {
   return std::stoi(text);
 }
 
+// The identity's entries, in order.
+std::vector<std::string> identityEntries(const std::string& identity) {
+  std::vector<std::string> entries;
+  for (size_t begin = 0; begin <= identity.size();) {
+    const size_t end = std::min(identity.find("; ", begin), identity.size());
+    entries.push_back(identity.substr(begin, end - begin));
+    begin = end + 2;
+  }
+  return entries;
+}
+
 }  // namespace
+
+std::string runDifference(const std::string& a, const std::string& b) {
+  const std::vector<std::string> x = identityEntries(a), y = identityEntries(b);
+  for (size_t i = 0; i < std::max(x.size(), y.size()); ++i) {
+    const std::string left = i < x.size() ? x[i] : "nothing", right = i < y.size() ? y[i] : "nothing";
+    if (left != right) return fmt::format("{} against {}", left, right);
+  }
+  return "no difference";
+}
 
 Shard parseShard(const std::string& text, const std::string& option) {
   const size_t slash = text.find('/');

@@ -12,4 +12,8 @@ struct Shard {
 // "K/N"; throws InputError naming `option` unless 0 ≤ K < N.
 Shard parseShard(const std::string& text, const std::string& option);
 
+// Where two runs' identities (cli/RunIdentity.h: entries joined by "; ") first differ,
+// for merge's refusal: "--seed 1 against --seed 2".
+std::string runDifference(const std::string& a, const std::string& b);
+
 }  // namespace misalloc

@@ -144,3 +144,76 @@ TEST_CASE("merge refuses bands that do not make one run's image, and writes noth
        {renderArgs(dir.path, "equal", "--shard 0/4 --out x.exr"), "fewer than the 4 bands"}},
       dir.path / "m.exr");
 }
+
+namespace {
+
+// Renders band `k` of 3 of the 16×40 image of `scene`, from `folder`, into dir/`name`:
+// relative input paths read that folder's files.
+void renderBandIn(const fs::path& dir, const std::string& folder, const std::string& scene, int k,
+                  const std::string& name) {
+  auto r = runMisalloc(
+      fmt::format("render {} --size 16x40 --spp 8 --method equal --device cpu --reference none --no-preview --report "
+                  "r.json --shard {}/3 --out {}",
+                  scene, k, (dir / name).string()),
+      fmt::format("cd {} &&", (dir / folder).string()));
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+}
+
+}  // namespace
+
+TEST_CASE("merge compares the bands' inputs by content and their options by final value, not by spelling",
+          "[band][cli][safety]") {
+  TempDir dir("band_identity");
+  // One name in three folders: `a` and `same` hold the same files, `other` other ones.
+  const std::string quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n";
+  for (const char* folder : {"a", "same", "other"}) {
+    const fs::path f = dir.path / folder;
+    fs::create_directories(f);
+    const float radiance = folder == std::string("other") ? 0.75f : 0.5f;
+    writeExr((f / "map.exr").string(), RgbImage{8, 4, std::vector<float>(96, radiance)});
+    writeText(f / "mesh.obj", folder == std::string("other") ? "v -1 -1 0.5\n" + quad.substr(10) : quad);
+    auto g =
+        runMisalloc(fmt::format("gbuffer --scene {} --size 16x40 --out {}",
+                                folder == std::string("other") ? "sphere" : "spheres:2x2", (f / "g.exr").string()));
+    INFO(g.output);
+    REQUIRE(g.exitCode == 0);
+  }
+  const std::string merge =
+      fmt::format("merge --out {} --report {} ", (dir.path / "m.exr").string(), (dir.path / "m.json").string());
+  auto merged = [&](const std::string& prefix, const std::string& last) {
+    return merge + fmt::format("{0}/{1}0.exr {0}/{1}1.exr {0}/{2}", dir.path.string(), prefix, last);
+  };
+  // The run's defaults spelled out, and the same map read from another folder: one run.
+  renderBandIn(dir.path, "a", "--envmap map.exr", 0, "map0.exr");
+  renderBandIn(dir.path, "a",
+               "--envmap map.exr --seed 1 --estimator multi --weights balance --envmap-pdf optimal --view 0 "
+               "--size 016x40",
+               1, "map1.exr");
+  renderBandIn(dir.path, "same", "--envmap map.exr", 2, "map2.exr");
+  auto m = runMisalloc(merged("map", "map2.exr"));
+  INFO(m.output);
+  CHECK(m.exitCode == 0);
+  fs::remove(dir.path / "m.exr");
+  fs::remove(dir.path / "m.json");
+  // A map, G-buffer or mesh of the same name with other contents: another run.
+  renderBandIn(dir.path, "other", "--envmap map.exr", 2, "other_map2.exr");
+  for (const char* input : {"gbuffer", "mesh"}) {
+    const std::string scene = input == std::string("gbuffer") ? "--envmap sun --gbuffer g.exr"
+                                                              : "--envmap sun --mesh mesh.obj --camera-origin 0,0,3";
+    renderBandIn(dir.path, "a", scene, 0, fmt::format("{}0.exr", input));
+    renderBandIn(dir.path, "a", scene, 1, fmt::format("{}1.exr", input));
+    renderBandIn(dir.path, "same", scene, 2, fmt::format("{}2.exr", input));
+    renderBandIn(dir.path, "other", scene, 2, fmt::format("other_{}2.exr", input));
+    m = runMisalloc(merged(input, fmt::format("{}2.exr", input)));
+    INFO(m.output);
+    CHECK(m.exitCode == 0);
+    fs::remove(dir.path / "m.exr");
+    fs::remove(dir.path / "m.json");
+  }
+  checkRefusals(dir.path,
+                {{merged("map", "other_map2.exr"), "envmap texels"},
+                 {merged("gbuffer", "other_gbuffer2.exr"), "gbuffer bytes"},
+                 {merged("mesh", "other_mesh2.exr"), "mesh bytes"}},
+                dir.path / "m.exr");
+}

@@ -45,6 +45,68 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());
 }
 
+namespace {
+
+// A 16×16 render of `scene` with `args`: its image's bytes and its report.
+std::pair<std::string, nlohmann::json> render16(const fs::path& dir, const std::string& scene,
+                                                const std::string& args) {
+  const fs::path out = dir / "r.exr", report = dir / "r.json";
+  auto r = runMisalloc(
+      fmt::format("render {} --size 16x16 --spp 100 --cost 1,1 --device cpu --reference none --no-preview --out {} "
+                  "--report {} {}",
+                  scene, out.string(), report.string(), args));
+  INFO(args << "\n" << r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream image(out, std::ios::binary);
+  return {std::string(std::istreambuf_iterator<char>(image), {}), nlohmann::json::parse(std::ifstream(report))};
+}
+
+// Where linear's weights go negative in places (the rules differ), and where exact's
+// predicted gain varies from pixel to pixel.
+const std::string kGlossy = "--envmap cosk:1 --grid uniform:0.5,0.5,20", kSun = "--envmap sun --grid seed000";
+
+}  // namespace
+
+TEST_CASE("render --linear-rule chooses how linear treats negative weights, and reaches the render",
+          "[cli][adaptive]") {
+  TempDir dir("linear_rule");
+  const auto variance = render16(dir.path, kGlossy, "--method linear --linear-rule variance");
+  const auto drop = render16(dir.path, kGlossy, "--method linear --linear-rule drop");
+  CHECK(render16(dir.path, kGlossy, "--method linear").second["allocation"]["zero_weight_rule"] ==
+        variance.second["allocation"]["zero_weight_rule"]);  // the default
+  CHECK(variance.second["allocation"]["zero_weight_rule"] == "min sample variance ([SS23] eq. 19)");
+  CHECK(drop.second["allocation"]["zero_weight_rule"] == "drop most negative ([SS23] Sec. 5.1)");
+  CHECK(variance.first != drop.first);
+  auto bad = runMisalloc("render --method linear --linear-rule both --size 4x4 --spp 8 --device cpu --out " +
+                         (dir.path / "x.exr").string());
+  CHECK(bad.exitCode == 2);
+  CHECK(bad.output.find("--linear-rule 'both'") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.path / "x.exr"));
+}
+
+TEST_CASE("render --skip-below keeps equal counts in more pixels as it rises, and reaches the render",
+          "[cli][adaptive]") {
+  TempDir dir("skip_below");
+  size_t before = 0;
+  std::string defaultImage;
+  for (const char* gain : {"0", "0.02", "0.3", "0.9"}) {
+    const auto [image, report] = render16(dir.path, kSun, std::string("--method exact --skip-below ") + gain);
+    INFO(gain);
+    CHECK(report["allocation"]["skip_below"] == std::stod(gain));
+    const size_t skipped = report["allocation"]["skipped_pixels"];
+    CHECK(skipped >= before);
+    before = skipped;
+    if (std::string(gain) == "0.02") {
+      CHECK(render16(dir.path, kSun, "--method exact").first == image);  // the default
+      CHECK(skipped < 256);
+      defaultImage = image;
+    }
+  }
+  // No predicted gain reaches 90 %: every pixel keeps equal counts, another image.
+  CHECK(before == 256);
+  CHECK(render16(dir.path, kSun, "--method exact --skip-below 0.9").first != defaultImage);
+}
+
 TEST_CASE("render --scene spheres writes the background transparent black, and reports its pdf and coverage",
           "[cli][scenes]") {
   TempDir dir;
@@ -108,6 +170,9 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--scene sphere --view 200", "--view 200"},
       {"--scene sphere --envmap-pdf optimal", "--envmap-pdf optimal with per-pixel normals or views: not implemented"},
       {"--scene sphere --product", "--product with per-pixel normals or views: not implemented"},
+      {"--product --method envmap", "--product with --method envmap: envmap samples the envmap alone"},
+      {"--product --method brdf", "--product with --method brdf: brdf samples the BRDF alone"},
+      {"--product --method ris --envmap-pdf plain", "--product with --method ris"},
   };
   for (const Case& c : cases) {
     auto r = runMisalloc(fmt::format("render --size 8x8 --spp 8 {} {}", outputs, c.args));

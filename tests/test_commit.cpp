@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cstdlib>
 
 #include "AtomicFile.h"
 #include "CliRunner.h"
@@ -63,8 +64,8 @@ TEST_CASE("a signal before the commit leaves every output as it was", "[cli][saf
   Workspace w;
   const std::string before = fingerprint(w.dir.path);
   // A reference of many samples keeps the run busy long before it commits.
-  pid_t pid = spawnMisalloc(renderWithAlpha(w) + " --reference auto --reference-spp 100000000 --cache-dir " +
-                            w.path("cache"));
+  pid_t pid =
+      spawnMisalloc(renderWithAlpha(w) + " --reference auto --reference-spp 100000000 --cache-dir " + w.path("cache"));
   REQUIRE(waitFor([&] { return fs::exists(w.dir.path / "cache" / "references"); }));
   REQUIRE(kill(pid, SIGTERM) == 0);
   const int status = waitStatus(pid);
@@ -82,7 +83,7 @@ TEST_CASE("what SIGKILL leaves behind is removed by the next run that writes the
   waitStatus(pid);
   CHECK(holdsTemporaries(w.dir.path));  // the temporaries not yet renamed
   // A temporary of a process that still runs (this one) is left alone.
-  const std::string live = fmt::format(".x.exr.tmp-{}-0", ::getpid());
+  const std::string live = fmt::format(".x.exr.tmp-{}-{}-0", misalloc::hostTag(), ::getpid());
   writeText(w.dir.path / live, "live");
   auto r = runMisalloc(renderWithAlpha(w));
   INFO(r.output);
@@ -95,12 +96,47 @@ TEST_CASE("what SIGKILL leaves behind is removed by the next run that writes the
   // The reference cache's folder likewise.
   const fs::path references = w.dir.path / "cache" / "references";
   fs::create_directories(references);
-  const std::string stale = fmt::format(".0123456789abcdef.exr.tmp-{}-0", deadPid());
+  const std::string stale = fmt::format(".0123456789abcdef.exr.tmp-{}-{}-0", misalloc::hostTag(), deadPid());
   writeText(references / stale, "left by a killed run");
   r = runMisalloc(w.render("--reference auto --reference-spp 16 --cache-dir " + w.path("cache")));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   CHECK_FALSE(fs::exists(references / stale));
+  CHECK_FALSE(holdsTemporaries(w.dir.path));
+}
+
+TEST_CASE("a writer's temporaries are its host's: another PID namespace's live ones are left alone",
+          "[cli][safety][signals]") {
+  // A second writer in a PID namespace of its own (a container, or another machine on a
+  // shared file system) whose PID runs nowhere here: its temporaries, in the folder
+  // while its commit pauses, must survive a run here that clears dead runs' leftovers.
+  if (::geteuid() != 0 || std::system("unshare -p -f --mount-proc true >/dev/null 2>&1") != 0) {
+    WARN("skipped: a PID namespace needs root and unshare");
+    return;
+  }
+  Workspace w;
+  const long pid = deadPid();
+  const std::string inner = fmt::format(
+      "unshare -p -f --mount-proc sh -c 'echo {} >/proc/sys/kernel/ns_last_pid; "
+      "MISALLOC_TEST_COMMIT_PAUSE_MS=1000 {} {} & wait $!' >/dev/null 2>&1",
+      pid - 1, misallocBinary(), renderWithAlpha(w));
+  const pid_t writer = fork();
+  REQUIRE(writer >= 0);
+  if (writer == 0) {
+    execl("/bin/sh", "sh", "-c", inner.c_str(), (char*)nullptr);
+    _exit(127);
+  }
+  REQUIRE(waitFor([&] { return earlierOutputs(w) < 5; }));  // committing: the others still temporaries
+  CHECK(holdsTemporaries(w.dir.path));
+  auto here = runMisalloc(fmt::format(
+      "render --envmap {} --size 4x4 --spp 8 --device cpu --reference none --no-preview --out {} --report {}",
+      w.path("env.exr"), w.path("here.exr"), w.path("here.json")));
+  INFO(here.output);
+  CHECK(here.exitCode == 0);
+  const int status = waitStatus(writer);
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  CHECK(earlierOutputs(w) == 0);  // every output of the other writer renamed into place
   CHECK_FALSE(holdsTemporaries(w.dir.path));
 }
 
@@ -130,7 +166,8 @@ TEST_CASE("compare replaces its folder whole, even when killed", "[cli][safety][
 TEST_CASE("a temporary name fits the file system whatever the output's name", "[cli][safety]") {
   Workspace w;
   const std::string name = std::string(246, 'n') + ".exr";  // 250 bytes: a legal name
-  auto r = runMisalloc(w.render(fmt::format("--out {} --report {}", w.path(name), w.path(std::string(245, 'r') + ".json"))));
+  auto r =
+      runMisalloc(w.render(fmt::format("--out {} --report {}", w.path(name), w.path(std::string(245, 'r') + ".json"))));
   INFO(r.output);
   CHECK(r.exitCode == 0);
   CHECK(fs::file_size(w.path(name)) > 0);

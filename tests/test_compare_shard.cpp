@@ -2,8 +2,10 @@
 // the unsharded run's folder, its images bit for bit and its errors to the digit (times
 // excluded), and merge's refusals of folders that do not make one run.
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <catch2/catch.hpp>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -155,5 +157,91 @@ TEST_CASE("merged shards of a comparison by scene and repeat are the unsharded r
                  {compareArgs(dir.path, kRepeats, "--shard-unit repeat --shard 0/4" + out), "fewer than the 4"},
                  {compareArgs(dir.path, kRepeats, "--shard-unit cube --shard 0/2" + out), "expected scene or repeat"},
                  {compareArgs(dir.path, kRepeats, "--shard-unit repeat" + out), "--shard-unit requires --shard"}},
+                dir.path / "m");
+}
+
+TEST_CASE("merge reads every run and file of the shards before it writes any, naming what is wrong",
+          "[compare][shard][cli][safety]") {
+  TempDir dir("compare_shard_files");
+  runShards(dir.path, kRepeats, "--shard-unit repeat", 2, {0, 1});
+  const std::string s0 = shardPath(dir.path, 0), s1 = shardPath(dir.path, 1);
+  std::string exr, png;  // an image and a preview of shard 0, which ran repeat 0
+  for (const std::string& f : filesUnder(s0)) {
+    if (exr.empty() && f.size() > 4 && f.substr(f.size() - 4) == ".exr") exr = f;
+    if (png.empty() && f.size() > 4 && f.substr(f.size() - 4) == ".png") png = f;
+  }
+  REQUIRE((!exr.empty() && !png.empty()));
+  // Copies of shard 0, each damaged once.
+  auto damaged = [&](const std::string& name, const std::function<void(const fs::path&)>& damage) {
+    const fs::path copy = dir.path / name;
+    fs::copy(s0, copy, fs::copy_options::recursive);
+    damage(copy);
+    return copy.string();
+  };
+  const std::string deleted = damaged("deleted", [&](const fs::path& c) { fs::remove(c / exr); });
+  const std::string flipped = damaged("flipped", [&](const fs::path& c) {
+    std::string bytes = readText(c / exr);
+    bytes[bytes.size() - 5] ^= 0x10;  // inside the pixels: it still decodes
+    writeText(c / exr, bytes);
+  });
+  const std::string truncated =
+      damaged("truncated", [&](const fs::path& c) { writeText(c / exr, readText(c / exr).substr(0, 100)); });
+  const std::string emptied = damaged("emptied", [&](const fs::path& c) { writeText(c / png, ""); });
+  const std::string stray = damaged("stray", [&](const fs::path& c) { writeText(c / "notes.txt", "mine"); });
+  const std::string lostRuns = damaged("lost_runs", [&](const fs::path& c) {
+    auto record = nlohmann::json::parse(readText(c / "shard.json"));
+    record["runs"].erase(record["runs"].begin(), record["runs"].begin() + 2);
+    writeText(c / "shard.json", record.dump());
+  });
+  const std::string fifo = damaged("fifo", [&](const fs::path& c) {
+    fs::remove(c / "shard.json");
+    REQUIRE(::mkfifo((c / "shard.json").c_str(), 0600) == 0);
+  });
+  const std::string merge = fmt::format("merge --out-dir {} ", (dir.path / "m").string());
+  checkRefusals(dir.path,
+                {{merge + deleted + " " + s1, (fs::path(deleted) / exr).string() + ": missing"},
+                 {merge + flipped + " " + s1, (fs::path(flipped) / exr).string() + ": its bytes differ"},
+                 {merge + truncated + " " + s1, (fs::path(truncated) / exr).string() + ": its bytes differ"},
+                 {merge + emptied + " " + s1, (fs::path(emptied) / png).string() + ": its bytes differ"},
+                 {merge + stray + " " + s1, (fs::path(stray) / "notes.txt").string() + ": a file the shard did not"},
+                 {merge + lostRuns + " " + s1, lostRuns + "/shard.json: holds 0 runs of"},
+                 {merge + fifo + " " + s1, fifo + "/shard.json: not a regular file"},
+                 // An output inside a shard, or in its place: refused before any work.
+                 {fmt::format("merge --out-dir {}/m {} {}", s0, s0, s1), "lies inside a shard"},
+                 {fmt::format("merge --out-dir {} {} {}", s1, s0, s1), "never replaces an input"}},
+                dir.path / "m");
+  CHECK_FALSE(fs::exists(fs::path(s0) / "m"));
+}
+
+TEST_CASE("merge takes shards that spell the run's options differently, and refuses shards of another map's texels",
+          "[compare][shard][cli][safety]") {
+  TempDir dir("compare_shard_identity");
+  // One name in three folders: `a` and `same` hold the same map, `other` another.
+  for (const char* folder : {"a", "same", "other"}) {
+    fs::create_directories(dir.path / folder);
+    const float radiance = folder == std::string("other") ? 0.75f : 0.5f;
+    misalloc::writeExr((dir.path / folder / "map.exr").string(),
+                       misalloc::RgbImage{8, 4, std::vector<float>(96, radiance)});
+  }
+  // Shard k of 2, by repeat, from `folder`, into dir/`name`.
+  auto shard = [&](const std::string& folder, int k, const std::string& spelled, const std::string& name) {
+    auto r = runMisalloc(
+        fmt::format("compare --envmap map.exr --repeats 2 --size 8x8 --cost 1,1.5 --reference-spp 64 --device cpu "
+                    "--cache-dir {} --shard-unit repeat --shard {}/2 --out-dir {} {}",
+                    (dir.path / "cache").string(), k, (dir.path / name).string(), spelled),
+        fmt::format("cd {} &&", (dir.path / folder).string()));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    return (dir.path / name).string();
+  };
+  const std::string s0 = shard("a", 0, "--methods equal,exact --budgets 16 --envmap-pdfs plain", "s0");
+  const std::string s1 =
+      shard("same", 1, "--methods equal,exact --budgets 16.0 --envmap-pdfs plain --weights balance --seed 1", "s1");
+  const std::string other = shard("other", 1, "--methods equal,exact --budgets 16 --envmap-pdfs plain", "other1");
+  auto m = runMisalloc(fmt::format("merge --out-dir {} {} {}", (dir.path / "merged").string(), s0, s1));
+  INFO(m.output);
+  CHECK(m.exitCode == 0);
+  checkRefusals(dir.path,
+                {{fmt::format("merge --out-dir {} {} {}", (dir.path / "m").string(), s0, other), "envmap texels"}},
                 dir.path / "m");
 }

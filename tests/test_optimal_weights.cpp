@@ -68,8 +68,10 @@ AdaptiveOptions optimalOptions(int techniqueCount) {
   return options;
 }
 
-Rendering renderOptimal(const Scene& scene, Method method, int spp, uint64_t seed) {
+Rendering renderOptimal(const Scene& scene, Method method, int spp, uint64_t seed,
+                        MisWeights weights = MisWeights::Optimal) {
   AdaptiveOptions options = optimalOptions(scene.techniqueCount());
+  options.weights = weights;
   const auto sampler = sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
   return render(*sampler, method, options, spp, seed);
 }
@@ -291,6 +293,29 @@ TEST_CASE("a render's pixels whose systems are ill-conditioned keep the balance 
   // A sharp lobe is no combination of them: every pixel solves.
   const Scene distinct = smallScene("cosk:1", "uniform:0.2,0.8,50", 16, 16);
   CHECK(renderOptimal(distinct, Method::Equal, 64, 5).weightsFallbacks.pixels == 0);
+}
+
+TEST_CASE("the optimal weights change a render: another image, of lower variance than the balance heuristic's",
+          "[weights]") {
+  // A sharp lobe under cos θ, where every pixel solves its system (the test above): the
+  // plane's pixels all integrate to eq. 6.17's value, so the mean squared error over
+  // the pixels estimates each render's variance per pixel. A wiring that dropped the
+  // solved weights would give the balance image bit for bit.
+  const Scene scene = smallScene("cosk:1", "uniform:0.2,0.8,50", 32, 32);
+  const double expected = closedForm(0.2, 0.8, 50, 1);
+  auto mse = [&](const Rendering& r) {
+    double sum = 0;
+    for (float v : r.image.rgb) sum += (v - expected) * (v - expected);
+    return sum / double(r.image.rgb.size());
+  };
+  const Rendering balance = renderOptimal(scene, Method::Equal, 64, 7, MisWeights::Balance);
+  const Rendering optimal = renderOptimal(scene, Method::Equal, 64, 7);
+  REQUIRE(optimal.weightsFallbacks.pixels == 0);
+  size_t differing = 0;
+  for (size_t i = 0; i < balance.image.rgb.size(); ++i) differing += balance.image.rgb[i] != optimal.image.rgb[i];
+  CHECK(differing > balance.image.rgb.size() / 2);
+  INFO(fmt::format("MSE balance {} optimal {}", mse(balance), mse(optimal)));
+  CHECK(mse(optimal) < 0.5 * mse(balance));  // 15 times lower with seed 7
 }
 
 TEST_CASE("renders with optimal weights are unbiased against [HS14] eq. 6.17", "[weights][unbiased]") {

@@ -6,13 +6,17 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "BiasCheck.h"
+#include "CliRunner.h"
 #include "Constants.h"
 #include "Error.h"
 #include "KernelCode.h"
+#include "SafetyWorkspace.h"
 #include "SceneFixtures.h"
 #include "Statistics.h"
 #include "TestDevice.h"
@@ -240,4 +244,37 @@ TEST_CASE("BRDF sampling alone gives the product technique no samples: technique
   const Scene split = smallScene("constant", "uniform:0.5,0.5,10", 4, 4, true);
   CHECK(split.techniqueNames() == std::vector<std::string>{"envmap", "diffuse", "specular"});
   CHECK(methodCounts(split, Method::Brdf, 16, 0) == std::vector<int>{0, 8, 8});
+}
+
+TEST_CASE("compare --product runs the methods that sample it, one scene with every pdf, and refuses the others",
+          "[product][compare][cli][bad-input]") {
+  TempDir dir("compare_product");
+  const std::string args = fmt::format(
+      "compare --envmap sun --size 8x8 --product --budgets 16 --repeats 1 --envmap-pdfs plain --reference-spp 64 "
+      "--cost 1,1,2 --device cpu --cache-dir {} ",
+      (dir.path / "cache").string());
+  auto all = runMisalloc(args + "--out-dir " + (dir.path / "all").string());
+  INFO(all.output);
+  REQUIRE(all.exitCode == 0);
+  std::set<std::string> methods;
+  const auto runs = nlohmann::json::parse(readText(dir.path / "all" / "runs.json"));
+  for (const auto& run : runs["runs"]) methods.insert(run["method"].get<std::string>());
+  CHECK(methods == std::set<std::string>{"equal", "heuristic", "sigma-sqrt-c", "linear", "exact", "oracle"});
+  // With the default pdfs, plain and optimal: one scene, in one plot and one column of the
+  // pdfs' table, as without --product.
+  auto pdfs = runMisalloc(fmt::format(
+      "compare --envmap sun --size 8x8 --product --methods equal,exact --budgets 16,32 --repeats 1 --reference-spp 64 "
+      "--cost 1,1,2 --device cpu --cache-dir {} --out-dir {}",
+      (dir.path / "cache").string(), (dir.path / "pdfs").string()));
+  INFO(pdfs.output);
+  REQUIRE(pdfs.exitCode == 0);
+  CHECK(fs::exists(dir.path / "pdfs" / "plot_sun-product.svg"));
+  CHECK_FALSE(fs::exists(dir.path / "pdfs" / "plot_sun-product-optimal.svg"));
+  const std::string table = readText(dir.path / "pdfs" / "envmap_pdfs.md");
+  CHECK(table.find("| sun-product | geometric mean |") != std::string::npos);
+  CHECK(table.find("—") == std::string::npos);  // every method with every pdf
+  auto ris = runMisalloc(args + "--methods equal,ris --out-dir " + (dir.path / "ris").string());
+  CHECK(ris.exitCode == 2);
+  CHECK(ris.output.find("--product with --method ris") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.path / "ris"));
 }

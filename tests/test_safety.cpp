@@ -10,15 +10,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <sstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "CliRunner.h"
-#include "SafetyWorkspace.h"
-#include "TestSize.h"
 #include "JsonText.h"
 #include "RawExr.h"
+#include "SafetyWorkspace.h"
+#include "TestSize.h"
 #include "paper/PaperReport.h"
 #include "scene/ExrIO.h"
 
@@ -27,7 +27,6 @@ namespace fs = std::filesystem;
 using misalloc::test::runMisalloc;
 using misalloc::test::TempDir;
 using namespace misalloc::test;
-
 
 TEST_CASE("an output that is an input, or another output, is refused and nothing is written", "[cli][safety]") {
   Workspace w;
@@ -116,16 +115,18 @@ TEST_CASE("compare's folder is replaced all or nothing", "[cli][safety][compare]
 
 TEST_CASE("a report holds any file name, valid UTF-8 or not", "[cli][safety]") {
   CHECK(misalloc::validUtf8("plain é ✓ 𝄞") == "plain é ✓ 𝄞");
-  CHECK(misalloc::validUtf8("a\xff" "b") == "a\\xFFb");
-  CHECK(misalloc::validUtf8("\xc3") == "\\xC3");                  // truncated sequence
-  CHECK(misalloc::validUtf8("\xc0\xaf") == "\\xC0\\xAF");         // overlong '/'
+  CHECK(misalloc::validUtf8("a\xff"
+                            "b") == "a\\xFFb");
+  CHECK(misalloc::validUtf8("\xc3") == "\\xC3");                    // truncated sequence
+  CHECK(misalloc::validUtf8("\xc0\xaf") == "\\xC0\\xAF");           // overlong '/'
   CHECK(misalloc::validUtf8("\xed\xa0\x80") == "\\xED\\xA0\\x80");  // a surrogate
   Workspace w;
   const std::string odd = w.path("map\xff\xfe.exr");
   fs::copy_file(w.path("env.exr"), odd);
-  auto r = runMisalloc(fmt::format("render --envmap '{}' --size 4x4 --spp 8 --device cpu --reference none --out {} "
-                                   "--report {}",
-                                   odd, w.path("odd.exr"), w.path("odd.json")));
+  auto r =
+      runMisalloc(fmt::format("render --envmap '{}' --size 4x4 --spp 8 --device cpu --reference none --out {} "
+                              "--report {}",
+                              odd, w.path("odd.exr"), w.path("odd.json")));
   INFO(r.output);
   REQUIRE(r.exitCode == 0);
   nlohmann::json report = nlohmann::json::parse(readText(w.path("odd.json")));
@@ -146,8 +147,8 @@ TEST_CASE("radiance near the float maximum is refused, naming the input, and wri
           "[cli][safety][finite]") {
   Workspace w;
   misalloc::writeExr(w.path("huge.exr"), misalloc::RgbImage{8, 4, std::vector<float>(96, 1e38f)});
-  const std::string huge[] = {"constant:1e38", "constant:1e31", "sun:40,90,0.5,1e38", "sun:40,90,0.5,1e30",
-                              "cosk:1e38", w.path("huge.exr")};
+  const std::string huge[] = {"constant:1e38",      "constant:1e31", "sun:40,90,0.5,1e38",
+                              "sun:40,90,0.5,1e30", "cosk:1e38",     w.path("huge.exr")};
   for (const std::string& envmap : huge) {
     for (const std::string& command :
          {fmt::format("render --envmap {} --size 4x4 --spp 8 --device cpu --cache-dir {} --out {} --report {}", envmap,
@@ -211,8 +212,8 @@ TEST_CASE("exit codes: 2 for bad input, 3 for OpenCL errors, 0 for help", "[cli]
       {"render --size 100000x100000", 2, "--size 100000x100000"},
       {"render --size 40000x40000 --reference none", 2, "--size 40000x40000"},
       {w.render("--cache-dir /proc/no/cache --reference auto"), 2, "--cache-dir /proc/no/cache"},
-      {fmt::format("compare --envmap constant --size 4x4 --methods equal --budgets 4 --out-dir /proc/no/out {}", cache), 2,
-       "--out-dir /proc/no/out"},
+      {fmt::format("compare --envmap constant --size 4x4 --methods equal --budgets 4 --out-dir /proc/no/out {}", cache),
+       2, "--out-dir /proc/no/out"},
       {w.render("--method linear --size 64x64 --spp 1000000000"), 2, "--spp 1000000000 with --method linear"},
       {fmt::format("compare --envmap constant --size 64x64 --methods linear --budgets 100,1000000 --out-dir {} {}",
                    w.path("cmp"), cache),
@@ -248,8 +249,8 @@ std::vector<std::string> withNotNumbers(std::vector<std::string> values) {
 
 // A whole number option in [lo, ...]: too small, too large or wrapped, fractional.
 NumericOption count(const std::string& option, long long lo, const std::string& tooLarge = "2147483648") {
-  return {option, withNotNumbers({std::to_string(lo - 1), "-1", tooLarge, "4294967297", "18446744073709551617", "1.5",
-                                  "1e3"})};
+  return {option,
+          withNotNumbers({std::to_string(lo - 1), "-1", tooLarge, "4294967297", "18446744073709551617", "1.5", "1e3"})};
 }
 
 }  // namespace
@@ -266,15 +267,17 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
                               w.path("cmp"), cache)},
   };
   const std::vector<NumericOption> scene = {
-      {"--size", {"0x4", "4x0", "-1x4", "4294967297x1", "1x4294967297", "65536x65536", "4", "4x", "x4", "nanx4",
-                  "4x4x4", "''", "1.5x4", "'4 x4'", "+4x4"}},
+      {"--size",
+       {"0x4", "4x0", "-1x4", "4294967297x1", "1x4294967297", "65536x65536", "4", "4x", "x4", "nanx4", "4x4x4", "''",
+        "1.5x4", "'4 x4'", "+4x4"}},
       {"--view", {"-1", "90", "1e309", "nan", "inf", "''", "junk", "10,nan", "10,inf", "10,", ",10", "1,2,3"}},
-      {"--grid", {"general:0,1,nan,1", "general:0,1,1,inf", "general:0,1,0,1", "general:0,2,1,1", "uniform:0.5,0.5",
-                  "uniform:0.5,0.5,1e6", "uniform:nan,0.5,1", "uniform:0.5,0.5,1,", "general:"}},
-      {"--envmap", {"constant:nan", "constant:-1", "constant:inf", "constant:", "constant:1e39", "cosk:-1",
-                    "cosk:nan", "cosk:1e39", "sun:40,90,0.5", "sun:181,90,0.5,1e5", "sun:40,nan,0.5,1e5",
-                    "sun:40,90,0,1e5", "sun:40,90,91,1e5", "sun:40,90,0.5,0", "sun:40,90,0.5,-1", "sun:40,90,0.5,1e39",
-                    "sun:40,90,0.5,1e5,1"}},
+      {"--grid",
+       {"general:0,1,nan,1", "general:0,1,1,inf", "general:0,1,0,1", "general:0,2,1,1", "uniform:0.5,0.5",
+        "uniform:0.5,0.5,1e6", "uniform:nan,0.5,1", "uniform:0.5,0.5,1,", "general:"}},
+      {"--envmap",
+       {"constant:nan", "constant:-1", "constant:inf", "constant:", "constant:1e39", "cosk:-1", "cosk:nan", "cosk:1e39",
+        "sun:40,90,0.5", "sun:181,90,0.5,1e5", "sun:40,nan,0.5,1e5", "sun:40,90,0,1e5", "sun:40,90,91,1e5",
+        "sun:40,90,0.5,0", "sun:40,90,0.5,-1", "sun:40,90,0.5,1e39", "sun:40,90,0.5,1e5,1"}},
       count("--procedural-width", 2, "16385"),
   };
   const std::vector<NumericOption> adaptive = {
@@ -283,6 +286,8 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
       count("--grid-u", 2, "16777217"),
       count("--oracle-spp", 2),
       count("--ris-candidates", 1, "17"),
+      count("--pool", 0, "4097"),
+      {"--skip-below", withNotNumbers({"-0.1", "1", "1.5", "1e309"})},
       {"--cost", {"1,nan", "1,inf", "1,0", "1,-1", "1", "1,2,3", "1,,2", "''", "junk,1", "1e309,1"}},
   };
   std::vector<std::pair<std::string, NumericOption>> table;
@@ -291,7 +296,8 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
   for (const std::string& base : {subcommands[0].second + " --method heuristic --spp 40",
                                   subcommands[2].second + " --methods heuristic --budgets 40"})
     for (const NumericOption& o : adaptive) table.push_back({base, o});
-  for (const std::string& base : {subcommands[0].second, subcommands[1].second}) table.push_back({base, count("--spp", 1)});
+  for (const std::string& base : {subcommands[0].second, subcommands[1].second})
+    table.push_back({base, count("--spp", 1)});
   table.push_back({subcommands[0].second, count("--reference-spp", 1)});
   table.push_back({subcommands[2].second, count("--reference-spp", 1)});
   for (const std::string& base : {subcommands[0].second, subcommands[2].second}) {
@@ -301,8 +307,9 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
   table.push_back({subcommands[2].second, count("--repeats", 1)});
   table.push_back({subcommands[2].second, count("--table-spp", 1)});
   table.push_back({subcommands[2].second,
-                   {"--budgets", {"0", "-4", "4.5", "10000001", "4,nan", "8,4", "4,4", "4,,8", "4,", "nan", "inf", "''", "junk",
-                                "1x", "0x10"}}});
+                   {"--budgets",
+                    {"0", "-4", "4.5", "10000001", "4,nan", "8,4", "4,4", "4,,8", "4,", "nan", "inf", "''", "junk",
+                     "1x", "0x10"}}});
   // Small test size (the sanitizers): each option's first and last bad value, through
   // the same parser and checks.
   for (auto& [base, o] : table)
@@ -318,7 +325,8 @@ TEST_CASE("every numeric option of every subcommand is checked in full range", "
   CHECK_FALSE(fs::exists(w.path("cmp")));
 }
 
-TEST_CASE("the reference cache cannot lie: a clash is refused, a damaged entry is computed again", "[cli][safety][cache]") {
+TEST_CASE("the reference cache cannot lie: a clash is refused, a damaged entry is computed again",
+          "[cli][safety][cache]") {
   Workspace w;
   const std::string cache = w.path("cache");
   const std::string run = w.render("--reference auto --reference-spp 16 --cache-dir " + cache);
@@ -353,20 +361,27 @@ TEST_CASE("the reference cache cannot lie: a clash is refused, a damaged entry i
     const char* reported;
   };
   const Damage damages[] = {
-      {"a flipped bit", [&] {
+      {"a flipped bit",
+       [&] {
          std::string bytes = trusted;
          bytes[bytes.size() / 2] ^= 0x10;
          writeText(entry, bytes);
-       }, "not trusted"},
+       },
+       "not trusted"},
       {"truncated", [&] { writeText(entry, trusted.substr(0, trusted.size() / 2)); }, "truncated or corrupt"},
       {"text", [&] { writeText(entry, "not an image"); }, "not an OpenEXR file"},
-      {"another size", [&] { misalloc::writeExr(entry.string(), misalloc::RgbImage{2, 2, std::vector<float>(12, 1.0f)}); },
+      {"another size",
+       [&] {
+         misalloc::writeExr(entry.string(), misalloc::RgbImage{2, 2, std::vector<float>(12, 1.0f)});
+       },
        "has no"},
-      {"NaN", [&] {
+      {"NaN",
+       [&] {
          misalloc::RgbImage nan{4, 4, std::vector<float>(48, 0.5f)};
          nan.rgb[5] = std::nanf("");
          misalloc::test::writeRawExr(entry.string(), nan);
-       }, "NaN"},
+       },
+       "NaN"},
   };
   for (const Damage& d : damages) {
     d.apply();
@@ -409,8 +424,7 @@ TEST_CASE("refusals that the options alone decide come before any work", "[cli][
       {w.render("--device :2 --reference auto --cache-dir " + cache), "--device :2: expected DEVICE:N"},
       {w.render("--method sigma-sqrt-c --spp 16 --stages 12 --reference auto --cache-dir " + cache),
        "a stage of 1 sample(s)"},
-      {w.render("--method exact --grid-rule entropy --spp 40 --reference auto --cache-dir " + cache),
-       "give --pool 0"},
+      {w.render("--method exact --grid-rule entropy --spp 40 --reference auto --cache-dir " + cache), "give --pool 0"},
   };
   checkRefusals(w.dir.path, cases, cache);  // no reference computed, no cache entry written
 }

@@ -25,6 +25,7 @@
 #include "compare/CompareReport.h"
 #include "compare/Comparison.h"
 #include "compare/EnvmapPdfComparison.h"
+#include "compare/ShardFiles.h"
 #include "compare/ShardRecord.h"
 #include "compare/ShardUnit.h"
 #include "compare/Suite.h"
@@ -32,6 +33,7 @@
 #include "compare/SummaryTables.h"
 #include "compare/WeightsComparison.h"
 #include "render/Reference.h"
+#include "render/RunChecks.h"
 
 namespace misalloc {
 namespace {
@@ -71,6 +73,21 @@ std::vector<int> parseBudgets(const std::string& list) {
   return budgets;
 }
 
+// The lists as parsed, in one spelling, written back to their options' variables, which
+// a shard's run identity reads (cli/RunIdentity.h): `--methods all` and the list of its
+// methods, `--budgets 16.0` and `16`, are one run.
+void writeBackLists(CompareArgs& args, const CompareOptions& compare, const std::vector<EnvmapPdf>& pdfs,
+                    const std::vector<MisWeights>& weights) {
+  std::vector<std::string> methods, pdfNames, weightNames;
+  for (Method m : compare.methods) methods.push_back(methodName(m));
+  for (const EnvmapPdf& pdf : pdfs) pdfNames.push_back(envmapPdfName(pdf));
+  for (MisWeights w : weights) weightNames.push_back(misWeightsName(w));
+  args.methods = fmt::format("{}", fmt::join(methods, ","));
+  args.budgets = fmt::format("{}", fmt::join(compare.budgets, ","));
+  args.envmapPdfs = fmt::format("{}", fmt::join(pdfNames, ","));
+  args.weights = fmt::format("{}", fmt::join(weightNames, ","));
+}
+
 int runCompare(CompareArgs& args) {
   InterruptionGuard guard;  // first: every thread started from here on inherits its mask
   CompareOptions& compare = args.compare;
@@ -103,6 +120,11 @@ int runCompare(CompareArgs& args) {
   const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
   compare.methods = parseMethodList(args.methods);
+  // envmap, brdf and ris never sample the product technique: with --product, "all" is the others.
+  if (args.methods == "all" && compare.cases.front().scene.product)
+    compare.methods.erase(std::remove_if(compare.methods.begin(), compare.methods.end(),
+                                         [](Method m) { return !takesProductTechnique(m); }),
+                          compare.methods.end());
   compare.budgets = parseBudgets(args.budgets);
   // Every scene with every pdf and then every weights; methods refused with the default
   // pdfs or with optimal weights are left out of those cases alone, saying why.
@@ -123,7 +145,10 @@ int runCompare(CompareArgs& args) {
     // Every shard knows the whole run's cases, in order, for the merge; the merge
     // checks the unit itself, to name it when shards of two units meet.
     shard.emplace();
-    shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"});
+    writeBackLists(args, compare, pdfs, weights);
+    std::vector<SceneOptions> scenes;
+    for (const CompareCase& c : compare.cases) scenes.push_back(c.scene);
+    shard->run = runIdentity(*args.command, {"--shard", "--shard-unit", "--out-dir", "--cache-dir", "--help"}, scenes);
     shard->shard = parseShard(args.shard, "--shard");
     shard->unit = unit;
     for (const CompareCase& c : variants(compare.cases)) shard->manifest.push_back(c.label);
@@ -156,6 +181,7 @@ int runCompare(CompareArgs& args) {
     shard->repeats = compare.repeats;
     shard->tableBudget = compare.tableBudget;
     shard->comparison = comparison;
+    shard->files = shardFileChecksums(compare.outDir);
     writeFileAtomically(compare.outDir + "/" + kShardRecordFile, shardRecordJson(*shard));
     outputs.commit();
     std::cout << fmt::format("shard {}: {} case(s), {} run(s) in {}; merge the shards with misalloc merge --out-dir\n",

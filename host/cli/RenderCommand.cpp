@@ -2,6 +2,7 @@
 // error against a reference.
 #include <fmt/format.h>
 
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -33,7 +34,7 @@ struct RenderCommandArgs {
   RenderArgs render;
   bool noPreview = false;
   std::string out = "render.exr", report = "render.json", alphaMap, shard;
-  std::string run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
+  std::function<std::string()> run;  // the run's identity (cli/RunIdentity.h), for a sharded render's bands
 };
 
 // A band of a sharded render writes its rows only: no preview, no α map.
@@ -99,7 +100,7 @@ int runRender(RenderCommandArgs& args) {
     report["band"] = {{"shard", args.shard},
                       {"rows", {band->rows.begin, band->rows.end}},
                       {"rendered_rows", {band->rendered.begin, band->rendered.end}}};
-    outputs.put(args.out, encodeBand(r.image, {args.run, *band, width, height, nodeName(), report}));
+    outputs.put(args.out, encodeBand(r.image, {args.run(), *band, width, height, nodeName(), report}));
   } else {
     outputs.put(args.out, encodeExr(r.image));
   }
@@ -146,8 +147,13 @@ Subcommand addRenderCommand(CLI::App& app) {
                    "K/N: render band K of N (whole rows of 16-pixel blocks) into --out, for `misalloc merge`")
       ->group("Outputs");
   return {command, [args, command] {
-            args->run = runIdentity(*command, {"--shard", "--out", "--report", "--no-preview", "--cache-dir",
-                                               "--reference", "--reference-spp", "--help"});
+            // Once runRender has resolved the scene's options and read its inputs.
+            args->run = [command, scene = &args->render.scene] {
+              return runIdentity(*command,
+                                 {"--shard", "--out", "--report", "--no-preview", "--cache-dir", "--reference",
+                                  "--reference-spp", "--help"},
+                                 {scene->options});
+            };
             return runRender(*args);
           }};
 }

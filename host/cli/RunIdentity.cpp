@@ -2,16 +2,74 @@
 
 #include <fmt/format.h>
 
-namespace misalloc {
+#include <fstream>
+#include <iterator>
 
-std::string runIdentity(const CLI::App& command, const std::set<std::string>& excluded) {
-  std::string identity = fmt::format("misalloc {} {}", MISALLOC_VERSION, command.get_name());
-  for (const CLI::Option* option : command.get_options()) {
-    if (option->count() == 0 || excluded.count(option->get_name())) continue;
-    identity += " " + option->get_name();
-    for (const std::string& value : option->results()) identity += " " + value;
+#include "ContentHash.h"
+#include "Error.h"
+#include "scene/Envmap.h"
+
+namespace misalloc {
+namespace {
+
+// The options that name a file: the identity holds the file's content instead, so that
+// one file reached by two paths (a relative path from two folders) is one input, and
+// two files of one name are two.
+const std::set<std::string> kInputOptions{"--envmap", "--gbuffer", "--mesh"};
+
+// An option's final value in one spelling. CLI11 converts an option's variable to text
+// with its default function: called after the command resolved its options, it gives
+// the value the run used, whether given (in any spelling: `--seed 01`) or left at its
+// default (the parse is over: the help's default text is no longer read). Flags have
+// no variable CLI11 can read: given or not; an option without a variable, its text.
+std::string finalValue(CLI::Option& option) {
+  if (option.get_expected_max() == 0) return option.count() > 0 && option.as<bool>() ? "true" : "false";
+  option.default_str("");
+  option.capture_default_str();
+  if (!option.get_default_str().empty() || option.count() == 0) return option.get_default_str();
+  return fmt::format("{}", fmt::join(option.results(), " "));
+}
+
+uint64_t envmapTexelHash(const SceneOptions& scene) {
+  const Envmap map = makeEnvmap(resolveEnvmapSpec(scene.envmap), scene.proceduralWidth);
+  ContentHash h;
+  h.addValue(map.image.width);
+  h.addValue(map.image.height);
+  h.addValue(map.coskExponent);
+  h.add(map.image.rgb.data(), map.image.rgb.size() * sizeof(float));
+  return h.h;
+}
+
+uint64_t fileHash(const std::string& option, const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  if (!file.good() && !file.eof()) throw InputError(fmt::format("{} {}: cannot be read", option, path));
+  ContentHash h;
+  h.add(bytes);
+  return h.h;
+}
+
+// A hash of each file the scene read, or of its procedural map's texels.
+void addInputHashes(const SceneOptions& scene, std::vector<std::string>& entries) {
+  entries.push_back(fmt::format("envmap texels {:016x}", envmapTexelHash(scene)));
+  if (!scene.gbuffer.path.empty())
+    entries.push_back(fmt::format("gbuffer bytes {:016x}", fileHash("--gbuffer", scene.gbuffer.path)));
+  if (!scene.mesh.path.empty())
+    entries.push_back(fmt::format("mesh bytes {:016x}", fileHash("--mesh", scene.mesh.path)));
+}
+
+}  // namespace
+
+std::string runIdentity(CLI::App& command, const std::set<std::string>& excluded,
+                        const std::vector<SceneOptions>& scenes) {
+  std::vector<std::string> entries{fmt::format("misalloc {} {}", MISALLOC_VERSION, command.get_name())};
+  for (CLI::Option* option : command.get_options()) {
+    const std::string& name = option->get_name();
+    if (excluded.count(name) || kInputOptions.count(name)) continue;
+    entries.push_back(fmt::format("{} {}", name, finalValue(*option)));
   }
-  return identity;
+  for (const SceneOptions& scene : scenes) addInputHashes(scene, entries);
+  return fmt::format("{}", fmt::join(entries, "; "));
 }
 
 }  // namespace misalloc

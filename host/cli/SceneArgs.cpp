@@ -99,7 +99,16 @@ SceneOptions SceneArgs::parsed() {
     options.envmapPdf = parseEnvmapPdf(envmapPdf);
   else
     options.envmapPdf = plainPdfByDefault ? EnvmapPdf{} : defaultEnvmapPdf(options);
+  writeBackResolved();
   return options;
+}
+
+// A run's identity (cli/RunIdentity.h) reads the options' variables: each holds what the
+// run uses, in one spelling, also where its default depends on other options.
+void SceneArgs::writeBackResolved() {
+  size = fmt::format("{}x{}", options.width, options.height);
+  view = fmt::format("{},{}", options.viewTheta, options.viewPhi);
+  envmapPdf = envmapPdfName(options.envmapPdf);
 }
 
 Scene SceneArgs::make() {
@@ -110,6 +119,7 @@ Scene SceneArgs::make() {
       (scene.grid.width != askedWidth || scene.grid.height != askedHeight))
     throw InputError(fmt::format("--size {}: the G-buffer {} is {}x{}", size, options.gbuffer.path, scene.grid.width,
                                  scene.grid.height));
+  size = fmt::format("{}x{}", scene.grid.width, scene.grid.height);  // a G-buffer's, given or not
   if (scene.grid.spec == kGBufferBrdf && app && app->count("--grid") > 0)
     throw InputError(
         fmt::format("--grid with --gbuffer {}: the G-buffer holds each pixel's BRDF (its channels "

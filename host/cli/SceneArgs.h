@@ -26,6 +26,9 @@ struct SceneArgs {
   SceneOptions parsed();
   // The scene, with a warning for each repair its envmap needed.
   Scene make();
+
+ private:
+  void writeBackResolved();
 };
 
 }  // namespace misalloc

@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <optional>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "Error.h"
@@ -14,10 +14,13 @@
 namespace misalloc {
 namespace {
 
-// The scene a case renders, whatever its pdf and weights: its scene JSON without the pdf.
+// The scene a case renders, whatever its pdf and weights: its scene JSON without the pdf,
+// and without how long the product technique's tables took to build (a time, which
+// differs from case to case).
 std::string sceneWithoutPdf(const CaseInfo& info) {
   nlohmann::json scene = info.scene;
   scene.erase("envmap_pdf");
+  if (scene.contains("product")) scene["product"].erase("build_seconds");
   return scene.dump();
 }
 

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "Error.h"
+#include "compare/ShardFiles.h"
 #include "compare/ShardRecord.h"
 
 namespace misalloc {
@@ -21,8 +22,8 @@ void requireOneRun(const std::vector<std::string>& folders, const std::vector<Sh
   for (size_t i = 0; i < records.size(); ++i) {
     const ShardRecord& r = records[i];
     if (r.run != first.run)
-      throw InputError(fmt::format("{} and {} are shards of different runs: '{}' and '{}'", folders.front(), folders[i],
-                                   first.run, r.run));
+      throw InputError(fmt::format("{} and {} are shards of different runs: {}", folders.front(), folders[i],
+                                   runDifference(first.run, r.run)));
     if (r.shard.count != first.shard.count)
       throw InputError(fmt::format("{} and {} split the run into {} and {} shards", folders.front(), folders[i],
                                    first.shard.count, r.shard.count));
@@ -40,6 +41,27 @@ void requireOneRun(const std::vector<std::string>& folders, const std::vector<Sh
   }
   for (size_t k = 0; k < seen.size(); ++k)
     if (seen[k] < 0) throw InputError(fmt::format("shard {}/{} is missing", k, first.shard.count));
+}
+
+// Refuses a case whose runs are not each of its methods at each budget and repeat,
+// exactly once: a record that lost or repeated a run would merge into tables that
+// compare methods over different samples. The shard that ran a repeat answers for it.
+void requireEveryRun(const CaseInfo& info, const std::vector<RunRecord>& runs, const ShardRecord& first,
+                     const std::vector<int>& holder, const std::vector<std::string>& folders) {
+  for (Method m : first.methods) {
+    if (std::any_of(info.leftOut.begin(), info.leftOut.end(), [&](const LeftOutMethod& l) { return l.method == m; }))
+      continue;
+    for (int budget : first.budgets)
+      for (size_t r = 0; r < holder.size(); ++r) {
+        const auto n = std::count_if(runs.begin(), runs.end(), [&](const RunRecord& run) {
+          return run.method == m && run.budget == budget && run.repeat == int(r);
+        });
+        if (n != 1)
+          throw InputError(fmt::format("{}/{}: holds {} runs of {} {} at {} spp, repeat {}, instead of one",
+                                       folders[size_t(holder[r])], kShardRecordFile, n, info.label, methodName(m),
+                                       budget, r));
+      }
+  }
 }
 
 const CaseInfo* findCase(const ShardRecord& record, const std::string& label) {
@@ -73,6 +95,8 @@ void mergeCase(const std::string& label, int repeats, const std::vector<std::str
   for (size_t r = 0; r < holder.size(); ++r)
     if (holder[r] < 0) throw InputError(fmt::format("no shard holds repeat {} of {}", r, label));
   CaseInfo info = *findCase(records[size_t(holder.front())], label);
+  requireEveryRun(info, {merged.runs.begin() + std::ptrdiff_t(firstRun), merged.runs.end()}, records.front(), holder,
+                  folders);
   info.repeats.resize(size_t(repeats));
   std::iota(info.repeats.begin(), info.repeats.end(), 0);
   merged.cases.push_back(std::move(info));
@@ -89,6 +113,7 @@ MergedComparison mergeShards(const std::vector<std::string>& folders) {
   std::vector<ShardRecord> records;
   for (const std::string& folder : folders) records.push_back(readShardRecord(folder));
   requireOneRun(folders, records);
+  for (size_t i = 0; i < folders.size(); ++i) requireShardFiles(folders[i], records[i]);
   const ShardRecord& first = records.front();
   MergedComparison merged;
   merged.options.methods = first.methods;

@@ -14,9 +14,11 @@ struct MergedComparison {
   Comparison comparison;
 };
 
-// Throws InputError, naming the folder, for a folder that is not a shard, shards of
-// different runs (options or versions) or units, a shard given twice or missing, a
-// repeat of a case that no shard or two shards hold, and an interrupted shard.
+// Throws InputError, naming the folder or file, for a folder that is not a shard, shards
+// of different runs (options, versions or inputs) or units, a shard given twice or
+// missing, a repeat of a case that no shard or two shards hold, a run missing or held
+// twice, a shard's file missing, damaged or not its own (compare/ShardFiles.h), and an
+// interrupted shard. Reads every file before the merge writes any.
 MergedComparison mergeShards(const std::vector<std::string>& folders);
 
 // Copies what the shard in `folder` wrote of its cases (images, α maps, previews) into

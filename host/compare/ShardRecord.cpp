@@ -90,15 +90,21 @@ std::string shardRecordJson(const ShardRecord& record) {
                    {"table_spp", record.tableBudget},
                    {"interrupted", record.comparison.interrupted},
                    {"cases", cases},
-                   {"runs", runs}});
+                   {"runs", runs},
+                   {"files", record.files}});
 }
 
 ShardRecord readShardRecord(const std::string& folder) {
   const std::filesystem::path path = std::filesystem::path(folder) / kShardRecordFile;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
     throw InputError(
         fmt::format("{}: not a shard of a comparison (compare --shard): it has no {}", folder, kShardRecordFile));
+  // A FIFO would block the read, a folder read as empty.
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw InputError(fmt::format("{}: not a regular file", path.string()));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot be read", path.string()));
   try {
     const nlohmann::json j = nlohmann::json::parse(std::string(std::istreambuf_iterator<char>(in), {}));
     ShardRecord r;
@@ -118,6 +124,7 @@ ShardRecord readShardRecord(const std::string& folder) {
     r.comparison.interrupted = j.at("interrupted");
     for (const auto& c : j.at("cases")) r.comparison.cases.push_back(caseInfoOf(c));
     for (const auto& run : j.at("runs")) r.comparison.runs.push_back(runRecordOf(run));
+    r.files = j.at("files").get<std::map<std::string, std::string>>();
     return r;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: its {} cannot be read: {}", folder, kShardRecordFile, e.what()));

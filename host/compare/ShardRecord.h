@@ -1,6 +1,7 @@
 #pragma once
 // The record a shard of a comparison (compare --shard K/N) leaves in its folder for
 // `misalloc merge --out-dir`.
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,12 +23,13 @@ struct ShardRecord {
   std::vector<int> budgets;
   int repeats = 0, tableBudget = 0;
   Comparison comparison;  // this shard's cases (with the repeats it ran) and runs, every number as measured
+  std::map<std::string, std::string> files;  // what it wrote, with checksums (compare/ShardFiles.h)
 };
 
 std::string shardRecordJson(const ShardRecord& record);
 
 // The record in `folder`; throws InputError naming the folder when it has none, or one
-// that cannot be read.
+// that is not a regular file or cannot be read.
 ShardRecord readShardRecord(const std::string& folder);
 
 }  // namespace misalloc

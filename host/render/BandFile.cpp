@@ -61,8 +61,8 @@ void requireOneRun(std::vector<ReadBand>& bands) {
   for (const ReadBand& b : bands) {
     const BandRecord& r = b.record;
     if (r.run != first.run)
-      throw InputError(fmt::format("{} and {} are bands of different runs: '{}' and '{}'", bands.front().path, b.path,
-                                   first.run, r.run));
+      throw InputError(fmt::format("{} and {} are bands of different runs: {}", bands.front().path, b.path,
+                                   runDifference(first.run, r.run)));
     if (r.width != first.width || r.height != first.height || r.band.shard.count != first.band.shard.count)
       throw InputError(
           fmt::format("{} and {} are bands of different images or shard counts", bands.front().path, b.path));

@@ -151,10 +151,19 @@ bool coversIntegrand(unsigned sampled, const SceneOptions& scene, Estimator esti
   return false;
 }
 
+bool takesProductTechnique(Method method) {
+  return method != Method::Envmap && method != Method::Brdf && method != Method::Ris;
+}
+
 void requireValidRun(const SceneOptions& scene, Method method, Estimator estimator, int spp,
                      const AdaptiveOptions& options) {
   const MethodTraits& traits = methodTraits(method);
   const int M = scene.techniqueCount();
+  if (scene.product && !takesProductTechnique(method))
+    throw InputError(fmt::format(
+        "--product with --method {}: {} samples {} alone and never the product technique; drop --product, or use "
+        "equal, heuristic, sigma-sqrt-c, linear, exact or oracle",
+        traits.name, traits.name, method == Method::Brdf ? "the BRDF" : "the envmap"));
   if (traits.fixesEstimator() && estimator != Estimator::MultiSample && estimator != traits.estimator)
     throw InputError(fmt::format("--estimator: --method {} {}", traits.name,
                                  traits.adaptive() ? "takes multi-sample stages"

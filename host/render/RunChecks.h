@@ -25,10 +25,16 @@ bool coversIntegrand(unsigned sampled, const SceneOptions& scene, Estimator esti
 // estimator.
 bool takesOptimalWeights(Method method, Estimator estimator);
 
+// Whether `method` can sample the product technique (--product): the splits over every
+// technique can; envmap, brdf and ris sample a technique of their own and would render
+// without it, the option ignored.
+bool takesProductTechnique(Method method);
+
 // Throws InputError, before any work, for a run of `method` on `scene` with `spp`
 // samples per pixel that the options make impossible (a schedule that does not fit the
 // budget, a probe too small, costs of the wrong count, the entropy rule with pooling,
-// optimal weights where no multi-sample balance heuristic runs) or biased: any stage
+// optimal weights where no multi-sample balance heuristic runs, --product with a method
+// that never samples it) or biased: any stage
 // whose counts could leave the sampled techniques short of covering the integrand, or a
 // technique without a sample in a stage with optimal weights. Render's floor gives every technique one sample of a
 // stage of at least M samples; a smaller allocated stage may go to any single technique.

@@ -9,6 +9,10 @@
 # --cache-dir. --wait returns when the merge has finished, with its exit status.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
+refuse() {
+  echo "submit.sh: $*" >&2
+  exit 2
+}
 kind=$1 n=$2 k=$3 out=$(realpath -m "$4")
 shift 4
 wait=()
@@ -20,11 +24,16 @@ fi
 case "$kind" in
   compare) script="$here/compare-shard.sbatch" ;;
   render) script="$here/render-band.sbatch" ;;
-  *) echo "submit.sh: the first argument is compare or render, not '$kind'" >&2; exit 2 ;;
+  *) refuse "the first argument is compare or render, not '$kind'" ;;
 esac
+[[ $n =~ ^[1-9][0-9]*$ ]] || refuse "N '$n': the number of shards is a whole number, at least 1"
+[[ $k =~ ^[1-9][0-9]*$ ]] || refuse "K '$k': the shards running at once are a whole number, at least 1"
+# sbatch expands % in --output (%x, %A, %j): a path holding one would send the logs elsewhere.
+[[ $out != *%* ]] || refuse "OUT '$out' holds '%', which sbatch's --output patterns expand; choose another folder"
 mkdir -p "$out"
 array=$(sbatch --parsable --array="0-$((n - 1))%$k" --output="$out/%x-%A_%a.out" "$script" "$out" "$@")
 array=${array%%;*}
 echo "submitted the $kind shards as job array $array"
-sbatch "${wait[@]}" --parsable --dependency="afterok:$array" --kill-on-invalid-dep=yes --output="$out/%x-%j.out" \
+# ${wait[@]+...}: an empty array under set -u is an unbound variable to bash before 4.4.
+sbatch ${wait[@]+"${wait[@]}"} --parsable --dependency="afterok:$array" --kill-on-invalid-dep=yes --output="$out/%x-%j.out" \
   "$here/merge.sbatch" "$kind" "$out" "$n"

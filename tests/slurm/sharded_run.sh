@@ -8,6 +8,32 @@
 set -euo pipefail
 misalloc=$1 source=$2
 skip() { echo "SKIPPED: $*"; exit 77; }
+
+# submit.sh's refusals, made before it creates OUT or submits anything: they need no
+# Slurm, and run wherever this test does, against an sbatch that only records its call.
+stub=$(mktemp -d /tmp/misalloc_submit.XXXXXX)
+trap 'rm -rf "$stub"' EXIT
+mkdir "$stub/bin"
+printf '#!/bin/sh\necho "$*" >>"%s/calls"\necho 1\n' "$stub" >"$stub/bin/sbatch"
+chmod +x "$stub/bin/sbatch"
+refused() {  # expected message, then submit.sh's arguments
+  local expected=$1 output
+  shift
+  if output=$(PATH="$stub/bin:$PATH" bash "$source/scripts/slurm/submit.sh" "$@" 2>&1); then
+    echo "FAILED: submit.sh $* was not refused"; exit 1
+  fi
+  [[ $output == *"$expected"* ]] || { echo "FAILED: submit.sh $*: '$output' lacks '$expected'"; exit 1; }
+  [ ! -e "$stub/calls" ] || { echo "FAILED: submit.sh $* called sbatch"; exit 1; }
+}
+for n in 0 -1 x 1.5 ""; do refused "N '$n'" render "$n" 1 "$stub/out" -- --envmap sun; done
+for k in 0 -2 y; do refused "K '$k'" compare 2 "$k" "$stub/out" -- --suite; done
+refused "holds '%'" render 2 1 "$stub/out%j" -- --envmap sun
+[ ! -e "$stub/out" ] && [ ! -e "$stub/out%j" ] || { echo "FAILED: a refused submit.sh created OUT"; exit 1; }
+# Without --wait, its array is empty: the merge's sbatch gets no empty argument.
+PATH="$stub/bin:$PATH" bash "$source/scripts/slurm/submit.sh" render 2 1 "$stub/out" -- --envmap sun >/dev/null
+grep -q -- '^--parsable --dependency=afterok:1 ' "$stub/calls" || { cat "$stub/calls"; echo "FAILED: the merge's sbatch"; exit 1; }
+rm -rf "$stub"
+echo "submit.sh: its refusals before any work, and a submission without --wait"
 [ "$(id -u)" -eq 0 ] || skip "a one-node Slurm starts its daemons as root; this runs as $(id -un)"
 for tool in munged slurmctld slurmd sbatch sinfo; do
   command -v "$tool" >/dev/null || skip "$tool is missing: .ci/setup installs Debian's slurm-wlm and munge"
@@ -18,8 +44,9 @@ scratch=$(mktemp -d /tmp/misalloc_slurm.XXXXXX)
 chmod 0755 "$scratch"  # munged, as the munge user, reaches its folder inside
 pids=()
 stop() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do
+  # ${pids[@]+...}: none started yet is an unbound variable under set -u to bash before 4.4.
+  for pid in ${pids[@]+"${pids[@]}"}; do kill "$pid" 2>/dev/null || true; done
+  for pid in ${pids[@]+"${pids[@]}"}; do
     for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
   done
   rm -rf "$scratch"
