@@ -162,8 +162,10 @@ void renderBandIn(const fs::path& dir, const std::string& folder, const std::str
 
 }  // namespace
 
+// Release only: 19 renders (20 s sanitized); the identity's code runs sanitized in
+// test_compare_shard.cpp ("merge takes shards that spell the run's options differently").
 TEST_CASE("merge compares the bands' inputs by content and their options by final value, not by spelling",
-          "[band][cli][safety]") {
+          "[band][cli][safety][release-only]") {
   TempDir dir("band_identity");
   // One name in three folders: `a` and `same` hold the same files, `other` other ones.
   const std::string quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n";

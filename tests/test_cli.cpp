@@ -84,8 +84,10 @@ TEST_CASE("render --linear-rule chooses how linear treats negative weights, and 
   CHECK_FALSE(fs::exists(dir.path / "x.exr"));
 }
 
+// Release only: six renders of exact (13 s sanitized); the skip rule's host code runs
+// sanitized in test_adaptive.cpp.
 TEST_CASE("render --skip-below keeps equal counts in more pixels as it rises, and reaches the render",
-          "[cli][adaptive]") {
+          "[cli][adaptive][release-only]") {
   TempDir dir("skip_below");
   size_t before = 0;
   std::string defaultImage;
