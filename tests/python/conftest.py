@@ -24,9 +24,13 @@ def cli():
     return run
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="session", autouse=True)
 def cache_dir(tmp_path_factory):
-    return tmp_path_factory.mktemp("cache")
+    """The session's cache, also the default of every scene and process that names none:
+    no test writes to the user's cache."""
+    path = tmp_path_factory.mktemp("cache")
+    os.environ["MISALLOC_CACHE_DIR"] = str(path)
+    return path
 
 
 def rgb(channels):
