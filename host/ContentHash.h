@@ -5,8 +5,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <type_traits>
+
+#include "Error.h"
 
 namespace misalloc {
 
@@ -38,5 +42,16 @@ struct ContentHash {
     h ^= h >> 32;
   }
 };
+
+// The hash of a file's bytes, for identities and checksums of files as written; throws
+// InputError naming `what` (an option, a path) if it cannot be read.
+inline uint64_t fileContentHash(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (!in.good() && !in.eof()) throw InputError(what + ": cannot be read");
+  ContentHash h;
+  h.add(bytes);
+  return h.h;
+}
 
 }  // namespace misalloc

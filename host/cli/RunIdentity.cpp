@@ -2,9 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
-#include <iterator>
-
 #include "ContentHash.h"
 #include "Error.h"
 #include "scene/Envmap.h"
@@ -40,22 +37,14 @@ uint64_t envmapTexelHash(const SceneOptions& scene) {
   return h.h;
 }
 
-uint64_t fileHash(const std::string& option, const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-  if (!file.good() && !file.eof()) throw InputError(fmt::format("{} {}: cannot be read", option, path));
-  ContentHash h;
-  h.add(bytes);
-  return h.h;
-}
-
 // A hash of each file the scene read, or of its procedural map's texels.
 void addInputHashes(const SceneOptions& scene, std::vector<std::string>& entries) {
   entries.push_back(fmt::format("envmap texels {:016x}", envmapTexelHash(scene)));
   if (!scene.gbuffer.path.empty())
-    entries.push_back(fmt::format("gbuffer bytes {:016x}", fileHash("--gbuffer", scene.gbuffer.path)));
+    entries.push_back(
+        fmt::format("gbuffer bytes {:016x}", fileContentHash(scene.gbuffer.path, "--gbuffer " + scene.gbuffer.path)));
   if (!scene.mesh.path.empty())
-    entries.push_back(fmt::format("mesh bytes {:016x}", fileHash("--mesh", scene.mesh.path)));
+    entries.push_back(fmt::format("mesh bytes {:016x}", fileContentHash(scene.mesh.path, "--mesh " + scene.mesh.path)));
 }
 
 }  // namespace

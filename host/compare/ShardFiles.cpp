@@ -3,8 +3,6 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <set>
 
 #include "ContentHash.h"
@@ -18,12 +16,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string fileChecksum(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (!in.good() && !in.eof()) throw InputError(fmt::format("{}: cannot be read", path.string()));
-  ContentHash h;
-  h.add(bytes);
-  return fmt::format("{:016x}", h.h);
+  return fmt::format("{:016x}", fileContentHash(path.string(), path.string()));
 }
 
 // What the shard's cases and runs write (compare/Comparison.cpp): each case's reference
