@@ -17,7 +17,7 @@ using namespace misalloc::test;
 
 namespace {
 
-// A 16×40 image: three bands of 16, 16 and 8 rows; given costs, as a sharded render needs.
+// A 16×40 image: three bands of 16, 16 and 8 rows; given costs, the same on every node.
 std::string renderArgs(const fs::path& dir, const std::string& method, const std::string& extra) {
   return fmt::format(
       "render --envmap sun --size 16x40 --spp 48 --method {} --cost 1,1.5 --device cpu --reference none --no-preview "
@@ -140,9 +140,39 @@ TEST_CASE("merge refuses bands that do not make one run's image, and writes noth
        {merge + b0 + " " + b1 + " " + (dir.path / "plain.exr").string(), "not a band of a sharded render"},
        {merge + b0 + " " + b1 + " " + b2 + " --out " + b1, "--out"},
        {renderArgs(dir.path, "exact", "--shard 3/3 --out x.exr"), "--shard '3/3'"},
-       {"render --envmap sun --size 16x40 --spp 48 --method exact --device cpu --reference none --shard 0/3", "--cost"},
        {renderArgs(dir.path, "equal", "--shard 0/4 --out x.exr"), "fewer than the 4 bands"}},
       dir.path / "m.exr");
+}
+
+TEST_CASE("bands without --cost allocate with the cost cache's one calibration", "[band][cli]") {
+  TempDir dir("band_costs");
+  // A band's sampler renders its rows, and takes the cached calibration of the whole
+  // image's: the first band calibrates, the others and the whole render read it.
+  auto render = [&](const std::string& cache, const std::string& extra, const std::string& out) {
+    auto r = runMisalloc(fmt::format(
+        "render --envmap sun --size 16x40 --spp 48 --method exact --device cpu --reference none --no-preview "
+        "--cache-dir {} --report {} --out {} {}",
+        (dir.path / cache).string(), (dir.path / "report.json").string(), (dir.path / out).string(), extra));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+  };
+  for (int k : {2, 0, 1}) render("cache", fmt::format("--shard {}/3", k), fmt::format("band{}.exr", k));
+  render("cache", "", "whole.exr");
+  CHECK(readText(dir.path / "report.json").find("\"costs_source\": \"cache\"") != std::string::npos);
+  auto merged = runMisalloc(fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "merged.exr").string(),
+                                        (dir.path / "merged.json").string(), bandPath(dir.path, 0),
+                                        bandPath(dir.path, 1), bandPath(dir.path, 2)));
+  INFO(merged.output);
+  REQUIRE(merged.exitCode == 0);
+  CHECK(readText(dir.path / "merged.exr") == readText(dir.path / "whole.exr"));
+  // A band calibrated apart (a node with a cache of its own) allocated with other costs.
+  render("elsewhere", "--shard 1/3", "apart.exr");
+  checkRefusals(dir.path,
+                {{fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "m.exr").string(),
+                              (dir.path / "m.json").string(), bandPath(dir.path, 0), (dir.path / "apart.exr").string(),
+                              bandPath(dir.path, 2)),
+                  "costs"}},
+                dir.path / "m.exr");
 }
 
 namespace {

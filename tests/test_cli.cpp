@@ -45,6 +45,37 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());
 }
 
+TEST_CASE("the default render is repeatable: its costs are calibrated once and cached", "[cli]") {
+  TempDir dir("repeatable");
+  // The default method allocates by cost: without the cache, each run would allocate
+  // with its own timings.
+  auto render = [&](const std::string& extra) {
+    const fs::path out = dir.path / "r.exr", report = dir.path / "r.json";
+    auto r = runMisalloc(fmt::format(
+        "render --envmap sun --size 32x32 --spp 64 --device cpu --no-preview --cache-dir {} --out {} --report {} {}",
+        (dir.path / "cache").string(), out.string(), report.string(), extra));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    std::ifstream image(out, std::ios::binary);
+    return std::make_pair(std::string(std::istreambuf_iterator<char>(image), {}),
+                          nlohmann::json::parse(std::ifstream(report)));
+  };
+  const auto [first, firstReport] = render("");
+  CHECK(firstReport["allocation"]["costs_source"] == "calibrated");
+  const auto [second, secondReport] = render("--cost cached");
+  CHECK(secondReport["allocation"]["costs_source"] == "cache");
+  CHECK(second == first);
+  nlohmann::json cachedModel = firstReport["allocation"]["cost_model"];
+  cachedModel["source"] = "cache";
+  CHECK(secondReport["allocation"]["cost_model"] == cachedModel);
+  const auto [measured, measuredReport] = render("--cost measure");
+  CHECK(measuredReport["allocation"]["costs_source"] == "calibrated");
+  CHECK(measuredReport["allocation"]["costs_s_per_sample"] != firstReport["allocation"]["costs_s_per_sample"]);
+  const auto [after, afterReport] = render("");
+  CHECK(after == measured);
+  CHECK(afterReport["allocation"]["costs_s_per_sample"] == measuredReport["allocation"]["costs_s_per_sample"]);
+}
+
 namespace {
 
 // A 16×16 render of `scene` with `args`: its image's bytes and its report.

@@ -1,11 +1,17 @@
 // The cost model (sampling/CostModel.h): the work a launch does as its work-groups run
 // it (sampling/LaunchWork.h), the fit on synthetic timing tables with a known answer,
-// and the calibration and per-stage predictions of a real render.
+// the calibration and per-stage predictions of a real render, and the cost cache
+// (render/CostCache.h) that makes the renders that allocate with it repeatable.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 
+#include "CliRunner.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "render/CostCache.h"
 #include "render/Render.h"
 #include "sampling/CostModel.h"
 
@@ -134,8 +140,8 @@ TEST_CASE("a render calibrates its sampler's model and predicts every stage", "[
   REQUIRE(r.costModel);
   CHECK_FALSE(r.costModel->isGiven());
   for (bool statistics : {false, true}) {
-    // Both kernels calibrated on 2M + 1 shapes, then refitted on the render's stages.
-    CHECK(r.costModel->launchCount(statistics) > 2 * scene.techniqueCount());
+    // Both kernels calibrated on 2M + 1 shapes.
+    CHECK(r.costModel->launchCount(statistics) == 2 * scene.techniqueCount() + 1);
     for (double c : r.costModel->perSample(statistics)) CHECK(c > 0);
   }
   REQUIRE(r.stages.size() == 3);
@@ -150,11 +156,14 @@ TEST_CASE("a render calibrates its sampler's model and predicts every stage", "[
   }
   CHECK(samples == spp);
 
-  SECTION("a second render refits the sampler's model on its stages, without calibrating again") {
-    const int plain = sampler.costModel().launchCount(false), statistics = sampler.costModel().launchCount(true);
-    render(sampler, Method::Exact, options, spp, 2);
-    CHECK(sampler.costModel().launchCount(false) == plain + 1);
-    CHECK(sampler.costModel().launchCount(true) == statistics + 2);
+  SECTION("a second render predicts with the same model: calibrated once, never refitted") {
+    const CostModel before = sampler.costModel();
+    const Rendering again = render(sampler, Method::Exact, options, spp, 2);
+    for (bool statistics : {false, true}) {
+      CHECK(again.costModel->launchCount(statistics) == before.launchCount(statistics));
+      CHECK(again.costModel->perSample(statistics) == before.perSample(statistics));
+      CHECK(again.costModel->perLaunch(statistics) == before.perLaunch(statistics));
+    }
   }
 }
 
@@ -166,4 +175,90 @@ TEST_CASE("fixed splits are timed but not predicted", "[costmodel]") {
   REQUIRE(r.stages.size() == 1);
   CHECK_FALSE(r.stages[0].predictedKernelSeconds);
   CHECK_FALSE(r.costModel);
+}
+
+namespace {
+
+bool sameCosts(const CostModel& a, const CostModel& b) {
+  for (bool statistics : {false, true})
+    if (a.perSample(statistics) != b.perSample(statistics) || a.perLaunch(statistics) != b.perLaunch(statistics) ||
+        a.launchCount(statistics) != b.launchCount(statistics))
+      return false;
+  return true;
+}
+
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST_CASE("the cost cache calibrates a sampler once and hands every later one the same model", "[costmodel]") {
+  TempDir dir("cost_cache");
+  const std::string cache = (dir.path / "cache").string();
+  const Scene scene = smallScene("cosk:4", "seed000", 32, 32);
+  AdaptiveOptions options;
+  const SamplerConfig config = samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, options);
+  Sampler first(testDevice(), scene, config);
+  provideCostModel(first, scene, {cache, false});
+  CHECK(first.costModel().source() == CostSource::Calibrated);
+  const std::string path = costCachePath(cache, costCacheKey(first, scene));
+  REQUIRE(std::filesystem::is_regular_file(path));
+
+  Sampler second(testDevice(), scene, config);
+  provideCostModel(second, scene, {cache, false});
+  CHECK(second.costModel().source() == CostSource::Cached);
+  CHECK(sameCosts(first.costModel(), second.costModel()));
+
+  SECTION("renders with the cached model are one image, bit for bit") {
+    const Rendering a = render(first, Method::Exact, options, 32, 7), b = render(second, Method::Exact, options, 32, 7);
+    CHECK(a.image.rgb == b.image.rgb);
+    CHECK(a.alpha == b.alpha);
+  }
+  SECTION("measure calibrates again and replaces the entry") {
+    const std::string before = readText(path);
+    Sampler third(testDevice(), scene, config);
+    provideCostModel(third, scene, {cache, true});
+    CHECK(third.costModel().source() == CostSource::Calibrated);
+    // Two calibrations' timings agree to the last bit only by chance.
+    CHECK(readText(path) != before);
+    Sampler fourth(testDevice(), scene, config);
+    provideCostModel(fourth, scene, {cache, false});
+    CHECK(sameCosts(third.costModel(), fourth.costModel()));
+  }
+  SECTION("a damaged entry is calibrated again and replaced, never used") {
+    std::string text = readText(path);
+    const size_t digit = text.find_first_of("123456789", text.find("per_sample_s"));
+    REQUIRE(digit != std::string::npos);
+    text[digit] = text[digit] == '9' ? '1' : char(text[digit] + 1);
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+    Sampler third(testDevice(), scene, config);
+    provideCostModel(third, scene, {cache, false});
+    CHECK(third.costModel().source() == CostSource::Calibrated);
+    Sampler fourth(testDevice(), scene, config);
+    provideCostModel(fourth, scene, {cache, false});
+    CHECK(fourth.costModel().source() == CostSource::Cached);
+    CHECK(sameCosts(third.costModel(), fourth.costModel()));
+  }
+  SECTION("another map, config or kernel build is another entry") {
+    const Scene other = smallScene("cosk:2", "seed000", 32, 32);
+    Sampler onOther(testDevice(), other, config);
+    CHECK(costCacheKey(onOther, other) != costCacheKey(first, scene));
+    Sampler heuristic(testDevice(), scene, samplerConfigFor(Method::Heuristic, Estimator::MultiSample, 32, options));
+    CHECK(costCacheKey(heuristic, scene) != costCacheKey(first, scene));
+    HostSampler host(scene, config);
+    CHECK(costCacheKey(host, scene) != costCacheKey(first, scene));
+  }
+}
+
+TEST_CASE("a cost cache that cannot be written leaves the render its own calibration", "[costmodel]") {
+  TempDir dir("cost_cache_file");
+  const std::string blocked = (dir.path / "not-a-folder").string();
+  std::ofstream(blocked) << "a file where the cache's folder would be";
+  const Scene scene = smallScene("cosk:4", "seed000", 16, 16);
+  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, AdaptiveOptions{}));
+  provideCostModel(sampler, scene, {blocked, false});
+  CHECK(sampler.costModel().source() == CostSource::Calibrated);
+  CHECK(std::filesystem::is_regular_file(blocked));
 }

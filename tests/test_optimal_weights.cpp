@@ -285,8 +285,8 @@ TEST_CASE("a render's pixels whose systems are ill-conditioned keep the balance 
   CHECK(r.weightsFallbacks.pixels == size_t(collinear.pixelCount()));
   CHECK(r.weightsFallbacks.illConditioned == size_t(collinear.pixelCount()));
   const AdaptiveOptions options = optimalOptions(2);
-  const nlohmann::json report = renderReport(
-      {collinear, Method::Equal, Estimator::MultiSample, options, "--cost", 64, 5, "test", r, std::nullopt});
+  const nlohmann::json report =
+      renderReport({collinear, Method::Equal, Estimator::MultiSample, options, 64, 5, "test", r, std::nullopt});
   CHECK(report["weights"]["rule"] == "optimal");
   CHECK(report["weights"]["fallback_pixel_fraction"] == 1.0);
   CHECK(report["weights"]["fallback_reasons"]["ill_conditioned"] == collinear.pixelCount());

@@ -4,6 +4,7 @@
 #include <set>
 #include <sstream>
 
+#include "ContentHash.h"
 #include "Error.h"
 
 namespace misalloc {
@@ -51,6 +52,18 @@ std::string kernelSource(const std::string& name) {
   std::ostringstream out;
   expand(name, stack, out);
   return out.str();
+}
+
+uint64_t embeddedSourcesHash() {
+  static const uint64_t hash = [] {
+    ContentHash h;
+    for (const auto& [name, text] : embeddedSources()) {  // a std::map: in name order
+      h.add(name);
+      h.add(text);
+    }
+    return h.h;
+  }();
+  return hash;
 }
 
 }  // namespace misalloc

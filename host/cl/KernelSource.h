@@ -1,4 +1,5 @@
 #pragma once
+#include <cstdint>
 #include <map>
 #include <string>
 
@@ -12,5 +13,9 @@ const std::map<std::string, std::string>& embeddedSources();
 // place, so the OpenCL compiler needs no include path. Includes of files that are not
 // embedded are left alone: they only occur in branches the OpenCL compiler skips.
 std::string kernelSource(const std::string& name);
+
+// A hash of every embedded file, names and texts: what the kernels are built from, and
+// what the host's C++ reference (KernelCode.h) compiles too.
+uint64_t embeddedSourcesHash();
 
 }  // namespace misalloc

@@ -43,8 +43,11 @@ void AdaptiveArgs::add(CLI::App& command) {
                   "exact: keep equal counts where the predicted gain of adapting is below this fraction")
       ->capture_default_str()
       ->check(realIn(0, 1, false, true));
-  costOption =
-      command.add_option("--cost", costList, "c1,c2[,c3]: cost per sample of each technique (default: measured)");
+  command
+      .add_option("--cost", costList,
+                  "adaptive methods: cached (the calibration cached for this device, kernel build and scene, made "
+                  "once), measure (calibrated again, and cached), or c1,c2[,c3] (cost per sample of each technique)")
+      ->capture_default_str();
   command.add_option("--linear-rule", linearRule, "linear: negative weights by variance ([SS23] eq. 19) or drop")
       ->capture_default_str();
   // α is a float: beyond 2^24 combinations, neighbouring weights would coincide.
@@ -68,7 +71,8 @@ AdaptiveOptions AdaptiveArgs::make(int techniqueCount) const {
   AdaptiveOptions o = options;
   o.linearRule = parseLinearRule(linearRule);
   o.gridRule = parseGridRule(gridRule);
-  if (costOption->count() > 0) o.costs = parseCosts(costList, techniqueCount);
+  o.measureCosts = costList == "measure";
+  if (costList != "cached" && !o.measureCosts) o.costs = parseCosts(costList, techniqueCount);
   return o;
 }
 

@@ -9,8 +9,7 @@ namespace misalloc {
 // The options of the adaptive methods (and of oracle and ris), shared by render and compare.
 struct AdaptiveArgs {
   AdaptiveOptions options;
-  std::string costList, linearRule = "variance", gridRule = "variance";
-  CLI::Option* costOption = nullptr;  // given, even as "", or not
+  std::string costList = "cached", linearRule = "variance", gridRule = "variance";
 
   void add(CLI::App& command);
 

@@ -7,8 +7,8 @@
 #include "Error.h"
 #include "OptionRange.h"
 #include "cli/StatisticsMemory.h"
+#include "render/CostCache.h"
 #include "render/RunChecks.h"
-#include "render/SceneBasis.h"
 #include "report/ImageMetrics.h"
 #include "report/Report.h"
 #include "scene/ExrIO.h"
@@ -84,20 +84,19 @@ RenderOutcome RenderArgs::render(const Scene& sampled, const Scene& plainScene, 
   RenderOutcome out;
   auto sampler = devices.makeSampler(sampled, plan.config, localSize);
   out.deviceName = devices.name();
-  SceneBasis basis = findSceneBasis(plainScene,
-                                    {!given && reference == "auto", referenceSpp, cacheDir,
-                                     methodTraits(plan.method).adaptive(), plan.adaptive.costs},
-                                    [&](const Scene& r) { return devices.makeSampler(r, SamplerConfig{}, localSize); });
-  out.reference = basis.reference ? std::move(basis.reference) : std::move(given);
-  out.costSource = basis.costSource;
-  plan.adaptive.costs = basis.costs;
+  if (!given && reference == "auto")
+    given = findReference(plainScene, referenceSpp, cacheDir,
+                          [&](const Scene& r) { return devices.makeSampler(r, SamplerConfig{}, localSize); });
+  out.reference = std::move(given);
+  if (methodTraits(plan.method).adaptive() && plan.adaptive.costs.empty())
+    provideCostModel(*sampler, plainScene, {cacheDir, plan.adaptive.measureCosts});
   out.rendering = misalloc::render(*sampler, plan.method, plan.adaptive, spp, seed);
   return out;
 }
 
 nlohmann::json RenderArgs::report(const Scene& s, const RenderPlan& plan, const RenderOutcome& outcome) const {
-  return renderReport({s, plan.method, plan.config.estimator, plan.adaptive, outcome.costSource, spp, seed,
-                       outcome.deviceName, outcome.rendering, outcome.reference});
+  return renderReport({s, plan.method, plan.config.estimator, plan.adaptive, spp, seed, outcome.deviceName,
+                       outcome.rendering, outcome.reference});
 }
 
 }  // namespace misalloc

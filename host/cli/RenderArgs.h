@@ -26,7 +26,6 @@ struct RenderPlan {
 struct RenderOutcome {
   Rendering rendering;
   std::optional<Reference> reference;
-  std::string costSource;  // SceneBasis::costSource
   std::string deviceName;
 };
 
@@ -51,9 +50,10 @@ struct RenderArgs {
   // --reference read where it names a file; none for auto and none.
   std::optional<Reference> referenceFile(const Scene& scene) const;
   // Renders `sampled` (the scene, or a band's rows of it) after finding the reference
-  // (unless `given`) and the costs of `plainScene`, the whole scene with the plain pdf
+  // of `plainScene` (unless `given`), the whole scene with the plain pdf
   // (withPlainEnvmapPdf): [Kar19]'s pdf changes the noise, not the integral, so one
-  // reference and one measurement of the costs serve every pdf.
+  // reference serves every pdf. An adaptive method without --cost allocates with the
+  // cost cache's model of its sampler for the whole image (render/CostCache.h).
   RenderOutcome render(const Scene& sampled, const Scene& plainScene, RenderPlan& plan, std::optional<Reference> given);
   // The JSON report of `outcome`, a render of `scene` planned by `plan`.
   nlohmann::json report(const Scene& scene, const RenderPlan& plan, const RenderOutcome& outcome) const;

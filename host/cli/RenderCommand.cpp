@@ -44,18 +44,19 @@ void refuseBandOutputs(RenderCommandArgs& args) {
   args.noPreview = true;
 }
 
-// A sharded render's band (render/Band.h) and where its costs come from, checked before
-// any work.
+// A sharded render's band (render/Band.h), checked before any work.
 std::optional<Band> requestedBand(const RenderCommandArgs& args, const RenderPlan& plan, int height) {
   if (args.shard.empty()) return std::nullopt;
-  // Costs measured by each band on its own node would differ, and so would the bands'
-  // allocations: a seam. Every band takes the same costs.
-  if (methodTraits(plan.method).adaptive() && plan.adaptive.costs.empty())
-    throw InputError(
-        fmt::format("--shard with --method {}: give the costs with --cost (every band must allocate with "
-                    "the same costs; a render's report has them as costs_s_per_sample)",
-                    args.render.method));
   return bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(plan.method, plan.adaptive));
+}
+
+// A band's run identity: the run's, and the costs it allocated with. Bands that share a
+// cost cache take one calibration (render/CostCache.h); bands calibrated apart (nodes of
+// other devices, or caches not shared) allocate differently, and their merge is refused.
+std::string bandIdentity(const std::string& run, const Rendering& r) {
+  if (!r.costModel) return run;
+  return fmt::format("{}; costs {} (statistics kernel {})", run, fmt::join(r.costModel->perSample(false), ","),
+                     fmt::join(r.costModel->perSample(true), ","));
 }
 
 int runRender(RenderCommandArgs& args) {
@@ -100,7 +101,7 @@ int runRender(RenderCommandArgs& args) {
     report["band"] = {{"shard", args.shard},
                       {"rows", {band->rows.begin, band->rows.end}},
                       {"rendered_rows", {band->rendered.begin, band->rendered.end}}};
-    outputs.put(args.out, encodeBand(r.image, {args.run(), *band, width, height, nodeName(), report}));
+    outputs.put(args.out, encodeBand(r.image, {bandIdentity(args.run(), r), *band, width, height, nodeName(), report}));
   } else {
     outputs.put(args.out, encodeExr(r.image));
   }

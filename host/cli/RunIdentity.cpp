@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
+
 #include "ContentHash.h"
 #include "Error.h"
 #include "scene/Envmap.h"
@@ -25,6 +28,26 @@ std::string finalValue(CLI::Option& option) {
   option.capture_default_str();
   if (!option.get_default_str().empty() || option.count() == 0) return option.get_default_str();
   return fmt::format("{}", fmt::join(option.results(), " "));
+}
+
+// A value's comma-separated items that are whole finite numbers in one spelling, the
+// shortest that reads back as the same double: a text option that holds numbers
+// (`--cost 1.0,2` and `--cost 1,2e0`) has one value however it was typed.
+std::string canonicalNumbers(const std::string& value) {
+  std::vector<std::string> items;
+  size_t begin = 0;
+  while (true) {
+    const size_t end = value.find(',', begin);
+    std::string item = value.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+    char* parsed = nullptr;
+    const double number = item.empty() ? 0 : std::strtod(item.c_str(), &parsed);
+    if (!item.empty() && parsed == item.c_str() + item.size() && std::isfinite(number))
+      item = fmt::format("{}", number);
+    items.push_back(std::move(item));
+    if (end == std::string::npos) break;
+    begin = end + 1;
+  }
+  return fmt::format("{}", fmt::join(items, ","));
 }
 
 uint64_t envmapTexelHash(const SceneOptions& scene) {
@@ -55,7 +78,7 @@ std::string runIdentity(CLI::App& command, const std::set<std::string>& excluded
   for (CLI::Option* option : command.get_options()) {
     const std::string& name = option->get_name();
     if (excluded.count(name) || kInputOptions.count(name)) continue;
-    entries.push_back(fmt::format("{} {}", name, finalValue(*option)));
+    entries.push_back(fmt::format("{} {}", name, canonicalNumbers(finalValue(*option))));
   }
   for (const SceneOptions& scene : scenes) addInputHashes(scene, entries);
   return fmt::format("{}", fmt::join(entries, "; "));

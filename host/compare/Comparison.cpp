@@ -11,19 +11,26 @@
 #include "JsonText.h"
 #include "compare/ProgressMeter.h"
 #include "render/BandFile.h"
+#include "render/CostCache.h"
 #include "render/Reference.h"
 #include "render/RunChecks.h"
-#include "render/SceneBasis.h"
 #include "report/AlphaMap.h"
 #include "report/ImageMetrics.h"
 #include "report/PreviewPng.h"
-#include "report/RunSummary.h"
 #include "report/Report.h"
+#include "report/RunSummary.h"
 #include "sampling/SamplerChoice.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
 namespace {
+
+// Where a case's adaptive renders take their costs (each run's costs_source says which
+// of the cache or a calibration it was).
+std::string costPolicy(const AdaptiveOptions& adaptive) {
+  if (!adaptive.costs.empty()) return "--cost";
+  return adaptive.measureCosts ? "calibrated (--cost measure), then cached" : "the cost cache";
+}
 
 std::string runStem(const std::string& caseLabel, Method method, int budget) {
   return fmt::format("{}/{}_{}spp", caseLabel, methodName(method), budget);
@@ -54,6 +61,7 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.weightsFallbackFraction = s.weightsFallbackFraction;
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
   rec.stages = r.stages;
+  if (r.costModel) rec.costSource = costSourceName(r.costModel->source());
   return rec;
 }
 
@@ -77,6 +85,7 @@ nlohmann::json runJson(const RunRecord& r) {
           {"skipped_pixel_fraction", r.skippedFraction},
           {"weights_fallback_pixel_fraction", r.weightsFallbackFraction},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
+          {"costs_source", r.costSource},
           {"stages", stagesJson(r.stages)}};
 }
 
@@ -176,33 +185,33 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
     const std::vector<Method> methods = caseMethods(c, options.methods);
     Scene scene = makeScene(c.scene);
     fs::create_directories(fs::path(options.outDir) / c.label);
-    // The reference and the costs with the plain envmap pdf ([Kar19]: withPlainEnvmapPdf).
+    // The reference of the plain envmap pdf's scene ([Kar19]: withPlainEnvmapPdf).
     const Scene plainScene = withPlainEnvmapPdf(scene);
-    meter.note(
-        fmt::format("{}: reference ({} spp, computed once and cached) and costs", c.label, options.referenceSpp));
-    SceneBasis basis = findSceneBasis(
-        plainScene, {true, options.referenceSpp, options.cacheDir, true, options.adaptive.costs},
-        [&](const Scene& s) { return devices.makeSampler(s, SamplerConfig{}, options.localSize); });
-    const std::optional<Reference>& reference = basis.reference;
+    meter.note(fmt::format("{}: reference ({} spp, computed once and cached)", c.label, options.referenceSpp));
+    const Reference reference = findReference(plainScene, options.referenceSpp, options.cacheDir, [&](const Scene& s) {
+      return devices.makeSampler(s, SamplerConfig{}, options.localSize);
+    });
     AdaptiveOptions adaptive = options.adaptive;
-    adaptive.costs = basis.costs;
     adaptive.weights = c.weights;
     double referenceVariance = 0;
-    for (float e : reference->standardError) referenceVariance += double(e) * e / double(reference->image.rgb.size());
-    out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, basis.costSource,
-                         reference->source, referenceVariance, devices.name(), c.leftOut, c.repeats, c.weights});
+    for (float e : reference.standardError) referenceVariance += double(e) * e / double(reference.image.rgb.size());
+    out.cases.push_back({c.label, sceneJson(scene), scene.techniqueNames(), adaptive.costs, costPolicy(adaptive),
+                         reference.source, referenceVariance, devices.name(), c.leftOut, c.repeats, c.weights});
     const CaseInfo& info = out.cases.back();
-    const double exposure = previewExposure(reference->image);
-    writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference->image, exposure);
+    const double exposure = previewExposure(reference.image);
+    writePreviewPng(fmt::format("{}/{}/reference.png", options.outDir, c.label), reference.image, exposure);
     // The repeats go round the methods, so that a stretch of load from elsewhere on a
     // shared machine slows one repeat of every method rather than every repeat of one:
     // the median times then compare methods under the same conditions.
     for (int budget : options.budgets) {
       // Built (and their kernels compiled) once per budget; each render starts afresh.
       std::vector<std::unique_ptr<StageSampler>> samplers;
-      for (Method method : methods)
+      for (Method method : methods) {
         samplers.push_back(devices.makeSampler(
             scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize));
+        if (isAdaptive(method) && adaptive.costs.empty())
+          provideCostModel(*samplers.back(), plainScene, {options.cacheDir, adaptive.measureCosts});
+      }
       for (int r : c.repeats)
         for (size_t m = 0; m < methods.size(); ++m) {
           const Method method = methods[m];
@@ -213,7 +222,7 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
           }
           const uint64_t seed = options.seed + uint64_t(r);
           Rendering rendering = render(*samplers[m], method, adaptive, budget, seed);
-          out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, *reference));
+          out.runs.push_back(recordRun(info, method, budget, r, seed, rendering, reference));
           if (r == 0) {
             std::string image = options.outDir + "/" + imagePath(c.label, method, budget);
             writeExr(image, rendering.image);

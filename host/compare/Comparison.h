@@ -36,7 +36,7 @@ struct CompareOptions {
   int repeats = 4;           // independent seeds per (method, budget)
   uint64_t seed = 1;         // repeat r uses seed + r
   int tableBudget = 200;     // the spp of the Table 5.2 layout (the nearest budget)
-  AdaptiveOptions adaptive;  // costs empty: each sampler's own (sampling/CostModel.h)
+  AdaptiveOptions adaptive;  // costs empty: each sampler's model from the cost cache (render/CostCache.h)
   std::string device = "auto";
   int localSize = 0;  // 0: each device's own (cl/LaunchShape.h)
   int referenceSpp = 16384;
@@ -57,13 +57,14 @@ struct RunRecord {
   // table, curve and speed-up uses; one repeat's may be below 0), with its standard
   // error, and the raw MSE.
   double mse = 0, mseStandardError = 0, rawMse = 0, relativeMse = 0;
-  std::vector<double> meanAlpha;  // per technique
-  double fallbackFraction = 0;    // pixels where an allocation rule fell back
-  double flooredFraction = 0;     // pixels whose counts were raised to one per technique
-  double skippedFraction = 0;     // pixels the skip rule kept at equal weights
+  std::vector<double> meanAlpha;       // per technique
+  double fallbackFraction = 0;         // pixels where an allocation rule fell back
+  double flooredFraction = 0;          // pixels whose counts were raised to one per technique
+  double skippedFraction = 0;          // pixels the skip rule kept at equal weights
   double weightsFallbackFraction = 0;  // optimal weights: pixels a stage left at the balance heuristic
   double statisticsBytesPerPixel = 0;
   std::vector<StageTiming> stages;  // kernel times, predicted and measured
+  std::string costSource;           // adaptive methods: their cost model's (costSourceName)
 
   // 1/(MSE × time): what a method buys per second.
   double efficiency() const { return 1.0 / (mse * wallSeconds); }
@@ -75,7 +76,7 @@ struct CaseInfo {
   nlohmann::json scene;
   std::vector<std::string> techniques;
   std::vector<double> costs;
-  std::string costSource;  // "calibrated" (each sampler's CostModel) or "--cost"
+  std::string costSource;  // "--cost", or the cost cache's calibrations (render/CostCache.h)
   std::string referenceSource;
   double referenceVariance = 0;  // its own error: Var(r), mean over pixels and channels
   std::string device;

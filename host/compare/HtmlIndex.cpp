@@ -74,11 +74,12 @@ std::string indexHtml(const Summary& s) {
     const CaseInfo& first = scene.cases.front()->info;
     out += fmt::format("<h2 id=\"{0}\">{0}</h2>\n", scene.label);
     out += fmt::format("<p class=\"note\">Costs per sample: {}. Reference: {}.</p>\n",
-                       first.costs.empty() ? "calibrated on each render's own kernels (runs.json: stages)"
+                       first.costs.empty() ? "calibrated once per device, kernel build and scene, and cached "
+                                             "(runs.json: costs_source)"
                                            : fmt::format("{:.3g} s (--cost)", fmt::join(first.costs, ", ")),
                        first.referenceSource);
-    out += fmt::format("<img src=\"{}\" alt=\"error against time, every method and pdf\">\n",
-                       plotFileName(scene.label));
+    out +=
+        fmt::format("<img src=\"{}\" alt=\"error against time, every method and pdf\">\n", plotFileName(scene.label));
     for (const CaseSummary* c : scene.cases) {
       if (scene.cases.size() > 1) out += fmt::format("<h3 id=\"{0}\">{0}</h3>\n", c->info.label);
       for (const LeftOutMethod& l : c->info.leftOut)

@@ -26,6 +26,7 @@ nlohmann::json runRecordJson(const RunRecord& r) {
           {"mean_alpha", r.meanAlpha},
           {"fractions", {r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.weightsFallbackFraction}},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
+          {"costs_source", r.costSource},
           {"stages", stagesJson(r.stages)}};
 }
 
@@ -46,6 +47,7 @@ RunRecord runRecordOf(const nlohmann::json& j) {
   r.fallbackFraction = f.at(0), r.flooredFraction = f.at(1), r.skippedFraction = f.at(2);
   r.weightsFallbackFraction = f.at(3);
   r.statisticsBytesPerPixel = j.at("statistics_bytes_per_pixel");
+  r.costSource = j.at("costs_source");
   for (const auto& s : j.at("stages")) {
     StageTiming t;
     t.samples = s.at("samples");

@@ -35,7 +35,6 @@ TextTable methodTable(const Summary& s, bool lowerBetter, Cell cell) {
   return table;
 }
 
-
 constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 
 std::pair<std::string, double> rmseCell(const Summary& s, const CaseSummary& c, Method m) {
@@ -181,10 +180,10 @@ std::string summaryMarkdown(const Summary& s) {
       for (const LeftOutMethod& l : c.info.leftOut)
         out += fmt::format("Not run in {}: {} ({}).\n\n", c.info.label, methodName(l.method), l.why);
     for (const CaseSummary& c : s.cases)
-      out += fmt::format("Reference of {}: {}; its own variance is {:.2f} % of the smallest error at {} spp (aim: at "
-                         "most 2 %), and is taken out of every error below.\n\n",
-                         c.info.label, c.info.referenceSource, 100 * referenceShare(c, s.budgets.back()),
-                         s.budgets.back());
+      out += fmt::format(
+          "Reference of {}: {}; its own variance is {:.2f} % of the smallest error at {} spp (aim: at "
+          "most 2 %), and is taken out of every error below.\n\n",
+          c.info.label, c.info.referenceSource, 100 * referenceShare(c, s.budgets.back()), s.budgets.back());
   }
   out += fmt::format(
       "## RMSE×1000 at {} spp\n\nThe layout of [HS14] Table 5.2: the RMSE of RGB over the image against the true "
@@ -212,8 +211,9 @@ std::string summaryMarkdown(const Summary& s) {
   for (const CaseSummary& c : s.cases) out += "\n### " + c.info.label + "\n\n" + markdown(equalTimeTable(c));
   if (s.costModel)
     out += fmt::format(
-        "\n## Cost model\n\nThe adaptive methods allocate with a model of each stage's kernel time, calibrated on the "
-        "sampler's own launches and refitted after each stage. Over the {} stages of the adaptive renders, its "
+        "\n## Cost model\n\nThe adaptive methods allocate with a model of each stage's kernel time, calibrated once "
+        "per device, kernel build and scene and cached (runs.json: `costs_source`). Over the {} stages of the adaptive "
+        "renders, its "
         "prediction made before the stage ran was off by |predicted/measured − 1| = {:.1f} % (median), {:.1f} % at "
         "worst (runs.json: `stages`).\n",
         s.costModel->stages, 100 * s.costModel->median, 100 * s.costModel->worst);
@@ -281,8 +281,12 @@ nlohmann::json summaryJson(const Summary& s) {
     costModel = {{"stages", s.costModel->stages},
                  {"median_abs_relative_error", s.costModel->median},
                  {"worst_abs_relative_error", s.costModel->worst}};
-  return {{"interrupted", s.interrupted}, {"table_spp", s.tableBudget}, {"budgets", s.budgets},
-          {"methods", methods},         {"cases", cases},              {"cost_model", costModel}};
+  return {{"interrupted", s.interrupted},
+          {"table_spp", s.tableBudget},
+          {"budgets", s.budgets},
+          {"methods", methods},
+          {"cases", cases},
+          {"cost_model", costModel}};
 }
 
 }  // namespace misalloc

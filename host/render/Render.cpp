@@ -88,11 +88,10 @@ struct Progress {
 
 // Runs one stage with the given counts; the caller adds it to the estimate.
 // `keepStatistics` false for the last stage, which no allocation reads. With a
-// calibrated cost model, the stage's kernel time is predicted before it runs, and the
-// model then learns from the time it took; given costs (--cost) predict no seconds:
-// only their ratios are known to mean anything.
+// calibrated cost model, the stage's kernel time is predicted before it runs; given
+// costs (--cost) predict no seconds: only their ratios are known to mean anything.
 TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int32_t> counts, int stageSamples,
-                     uint64_t seed, bool keepStatistics, CostModel* costs,
+                     uint64_t seed, bool keepStatistics, const CostModel* costs,
                      std::vector<float> optimalCoefficients = {}) {
   TakenStage stage;
   stage.plan.optimalCoefficients = std::move(optimalCoefficients);
@@ -115,7 +114,6 @@ TakenStage takeStage(StageSampler& sampler, Progress& progress, std::vector<int3
   checkInterruption();
   stage.result = sampler.run(stage.plan, seed);
   timing.kernelSeconds = stage.result.kernelSeconds;
-  if (predicts) costs->observe(work, stage.result.kernelSeconds);
   progress.timings.push_back(timing);
   for (size_t i = 0; i < progress.taken.size(); ++i) progress.taken[i] += stage.plan.counts[i];
   progress.samplesBefore += stageSamples;
@@ -244,12 +242,12 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     throw std::logic_error("the sampler's config does not match the weights asked for (samplerConfigFor)");
   std::unique_ptr<StageAllocator> allocator;
   std::optional<CostModel> givenCosts;
-  CostModel* model = nullptr;
+  const CostModel* model = nullptr;
   if (traits.adaptive()) {
     allocator = makeStageAllocator(sampler, method, options);
     if (options.costs.empty()) {
-      // The sampler's own, calibrated at its first render before the clock starts, as
-      // its kernels' compilation is, and refitted on every stage it runs since.
+      // The sampler's own (set from the cost cache, or calibrated at its first render),
+      // found before the clock starts, as its kernels' compilation is.
       model = &sampler.costModel();
     } else {
       validateCosts(options.costs, M);

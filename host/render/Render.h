@@ -30,10 +30,11 @@ struct AdaptiveOptions {
   int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
   double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
   std::vector<double> costs;    // c_k per sample, one per technique (--cost); empty: the sampler's CostModel
+  bool measureCosts = false;    // --cost measure: the caller calibrates the samplers again (render/CostCache.h)
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
   GridRule gridRule = GridRule::MinCostVariance;
-  int oracleSamples = 1024;  // oracle: equal-count probe samples per pixel
+  int oracleSamples = 1024;                   // oracle: equal-count probe samples per pixel
   int risCandidates = kDefaultRisCandidates;  // ris: envmap candidates per sample ([TCE05])
   // The weights of every stage after the first: with Optimal, equal also runs a pilot
   // (render/Render.cpp, docs/methods.md).
@@ -54,11 +55,11 @@ struct StageTiming {
 
 struct Rendering {
   RgbImage image;
-  std::vector<double> variance;  // per pixel: estimated variance of the luminance estimate
-  std::vector<double> alpha;     // [pixel·M + k]: the share of the pixel's samples technique k took
-  size_t fallbackPixels = 0;     // pixels where an allocation rule fell back (alloc/Allocation.h)
-  size_t flooredPixels = 0;      // pixels where a stage's counts were raised to one per technique
-  size_t skippedPixels = 0;      // pixels that the skip rule kept at equal weights in every stage
+  std::vector<double> variance;              // per pixel: estimated variance of the luminance estimate
+  std::vector<double> alpha;                 // [pixel·M + k]: the share of the pixel's samples technique k took
+  size_t fallbackPixels = 0;                 // pixels where an allocation rule fell back (alloc/Allocation.h)
+  size_t flooredPixels = 0;                  // pixels where a stage's counts were raised to one per technique
+  size_t skippedPixels = 0;                  // pixels that the skip rule kept at equal weights in every stage
   OptimalWeightsFallbacks weightsFallbacks;  // --weights optimal: pixels a stage left at the balance heuristic
   int stageCount = 1;
   double meanPilotWeight = 0;          // staged methods: the pilot's weight in the estimate, mean over pixels
@@ -67,10 +68,10 @@ struct Rendering {
   double allocationSeconds = 0;        // reading statistics back and allocating
   double hostSeconds = 0;              // everything else: planning, transfers, reductions
   double wallSeconds = 0;
-  std::vector<DeviceShare> devices;  // where it ran (sampling/TiledSampler.h for several)
-  double imbalanceSeconds = 0;       // several devices: Σ over stages of last finish − first finish
-  std::vector<StageTiming> stages;   // the pilot (or the oracle's probe) first
-  std::optional<CostModel> costModel;  // adaptive methods: what they allocated with, refitted on this render's stages
+  std::vector<DeviceShare> devices;    // where it ran (sampling/TiledSampler.h for several)
+  double imbalanceSeconds = 0;         // several devices: Σ over stages of last finish − first finish
+  std::vector<StageTiming> stages;     // the pilot (or the oracle's probe) first
+  std::optional<CostModel> costModel;  // adaptive methods: what they allocated with
 };
 
 // Renders every pixel with `spp` samples: fixed splits in one stage, adaptive methods

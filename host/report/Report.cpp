@@ -138,8 +138,7 @@ nlohmann::json stagesJson(const std::vector<StageTiming>& stages) {
   return list;
 }
 
-nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames,
-                             const std::string& source) {
+nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames) {
   nlohmann::json kernels;
   for (bool statistics : {false, true}) {
     nlohmann::json perSample;
@@ -148,7 +147,7 @@ nlohmann::json costModelJson(const CostModel& model, const std::vector<std::stri
                                                          {"per_sample_s", perSample},
                                                          {"launches_fitted", model.launchCount(statistics)}};
   }
-  return {{"source", source},
+  return {{"source", costSourceName(model.source())},
           {"model", "T = t_0 + sum_k c_k S_k, S_k: technique k's sample slots as the work-groups run them"},
           {"kernels", kernels}};
 }
@@ -196,8 +195,8 @@ nlohmann::json renderReport(const RenderRun& run) {
         {"pool_radius", run.adaptive.poolRadius},
         {"skip_below", run.adaptive.minGain},
         {"costs_s_per_sample", costs},
-        {"costs_source", run.costSource},
-        {"cost_model", costModelJson(*r.costModel, names, run.costSource)},
+        {"costs_source", costSourceName(r.costModel->source())},
+        {"cost_model", costModelJson(*r.costModel, names)},
         {"fallback_pixels", r.fallbackPixels},
         {"fallback_pixel_fraction", summary.fallbackFraction},
         {"floored_pixels", r.flooredPixels},

@@ -14,7 +14,6 @@ struct RenderRun {
   Method method;
   Estimator estimator;
   const AdaptiveOptions& adaptive;
-  std::string costSource;  // "calibrated" (each sampler's CostModel) or "--cost"
   int spp;
   uint64_t seed;
   std::string device;
@@ -28,9 +27,8 @@ struct RenderRun {
 nlohmann::json renderReport(const RenderRun& run);
 // Each stage's kernel time and, for the adaptive methods, the cost model's prediction.
 nlohmann::json stagesJson(const std::vector<StageTiming>& stages);
-// The fitted (or given) costs of both kernels.
-nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames,
-                             const std::string& source);
+// The fitted (or given) costs of both kernels, and where they came from.
+nlohmann::json costModelJson(const CostModel& model, const std::vector<std::string>& techniqueNames);
 
 nlohmann::json sceneJson(const Scene& scene);
 

@@ -43,33 +43,53 @@ Eigen::VectorXd nonNegativeFit(const Eigen::MatrixXd& a, std::vector<int> free) 
 
 }  // namespace
 
+const char* costSourceName(CostSource source) {
+  switch (source) {
+    case CostSource::Given:
+      return "--cost";
+    case CostSource::Calibrated:
+      return "calibrated";
+    case CostSource::Cached:
+      return "cache";
+  }
+  throw std::logic_error("unknown cost source");
+}
+
 CostModel CostModel::given(std::vector<double> costs) {
   CostModel model(int(costs.size()));
-  for (Kernel& k : model.kernels_) k.perSample = costs;
-  model.given_ = true;
+  for (Kernel& k : model.kernels_) k.costs.perSample = costs;
+  model.source_ = CostSource::Given;
+  return model;
+}
+
+CostModel CostModel::cached(KernelCosts plain, KernelCosts withStatistics) {
+  CostModel model(int(plain.perSample.size()));
+  model.kernels_[0].costs = std::move(plain);
+  model.kernels_[1].costs = std::move(withStatistics);
+  model.source_ = CostSource::Cached;
   return model;
 }
 
 CostModel::CostModel(int techniqueCount) {
-  for (Kernel& k : kernels_) k.perSample.assign(techniqueCount, 0.0);
+  for (Kernel& k : kernels_) k.costs.perSample.assign(techniqueCount, 0.0);
 }
 
 void CostModel::observe(const LaunchWork& work, double seconds) {
-  if (given_ || !(seconds > 0)) return;
+  if (source_ != CostSource::Calibrated || !(seconds > 0)) return;
   Kernel& k = kernels_[work.keepsStatistics ? 1 : 0];
   k.seen.push_back({work.slots, seconds});
   fit(k);
 }
 
 double CostModel::predict(const LaunchWork& work) const {
-  const Kernel& k = kernel(work.keepsStatistics);
+  const KernelCosts& k = kernel(work.keepsStatistics).costs;
   double seconds = k.perLaunch;
   for (size_t i = 0; i < work.slots.size(); ++i) seconds += k.perSample[i] * work.slots[i];
   return seconds;
 }
 
 void CostModel::fit(Kernel& kernel) {
-  const int M = int(kernel.perSample.size()), unknowns = M + 1, n = int(kernel.seen.size());
+  const int M = int(kernel.costs.perSample.size()), unknowns = M + 1, n = int(kernel.seen.size());
   Eigen::MatrixXd a(n, unknowns);
   for (int i = 0; i < n; ++i) {
     const Launch& launch = kernel.seen[i];
@@ -86,14 +106,15 @@ void CostModel::fit(Kernel& kernel) {
   // allocations would have no cost to weigh. Without t_0 some c_k > 0 wherever a launch
   // had samples.
   if ((x.tail(M).array() <= 0).all()) x = nonNegativeFit(a, costs);
-  kernel.perLaunch = x(0);
+  kernel.costs.perLaunch = x(0);
+  kernel.costs.launches = n;
   // A technique whose samples the fit cannot tell from free (its time within the
   // noise of the others') costs what the cheapest measured one does: every cost > 0.
   double cheapest = 0;
   for (int k = 0; k < M; ++k)
     if (x(1 + k) > 0 && (cheapest == 0 || x(1 + k) < cheapest)) cheapest = x(1 + k);
   if (cheapest == 0) throw std::logic_error("cost model: no launch it was fitted on took a sample");
-  for (int k = 0; k < M; ++k) kernel.perSample[k] = x(1 + k) > 0 ? x(1 + k) : cheapest;
+  for (int k = 0; k < M; ++k) kernel.costs.perSample[k] = x(1 + k) > 0 ? x(1 + k) : cheapest;
 }
 
 namespace {

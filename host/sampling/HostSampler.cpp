@@ -1,10 +1,13 @@
 // HostSampler: the C++ reference of kernels/sample.cl, through host/KernelCode.h.
 #include "sampling/HostSampler.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 
 #include "KernelCode.h"
+#include "cl/KernelSource.h"
 #include "sampling/KernelViews.h"
 
 namespace misalloc {
@@ -69,6 +72,20 @@ HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
     : StageSampler(scene, config), stats_(size_t(scene.pixelCount()) * statSlots(), 0.0) {
   share_.name = kHostSamplerName;
   if (config.sampleCapacity > 0) samples_ = emptyStoredSamples(scene, config);
+}
+
+std::string HostSampler::launchIdentity() const {
+  // The C++ reference is this binary's code: the compiler and how it built it, and the
+  // kernel sources it mirrors, stand for its build.
+#if defined(__SANITIZE_ADDRESS__)
+  constexpr const char* kBuild = "sanitized";
+#elif defined(__OPTIMIZE__)
+  constexpr const char* kBuild = "optimised";
+#else
+  constexpr const char* kBuild = "unoptimised";
+#endif
+  return fmt::format("host C++ reference, {} {} build; kernel sources {:016x}", __VERSION__, kBuild,
+                     embeddedSourcesHash());
 }
 
 void HostSampler::forgetStages() {

@@ -21,6 +21,7 @@ class HostSampler : public StageSampler {
   StoredSampleBuffer storedSampleBuffer() override { return {nullptr, nullptr, &samples_}; }
 
   std::vector<DeviceShare> deviceShares() const override { return {share_}; }
+  std::string launchIdentity() const override;
 
  private:
   void forgetStages() override;

@@ -8,6 +8,7 @@
 #include "Constants.h"
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
+#include "cl/KernelSource.h"
 #include "cl/LaunchShape.h"
 #include "sampling/KernelViews.h"
 #include "sampling/LaunchWork.h"
@@ -113,13 +114,16 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   share_.launch = shape.why;
   if (pixelLanes_ > 0)
     share_.launch += fmt::format("; stages without running sums: one pixel per {} lanes", pixelLanes_);
-  const cl::Program plain =
-      buildProgram(device, "sample.cl", sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_));
-  plainKernel_ = cl::Kernel(plain, pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
-  kernel_ =
-      keepsStatistics(config)
-          ? cl::Kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize_)), "sampleStage")
-          : plainKernel_;
+  const std::string plainOptions = sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_),
+                    statisticsOptions = sampleKernelOptions(scene, config, localSize_);
+  plainKernel_ =
+      cl::Kernel(buildProgram(device, "sample.cl", plainOptions), pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
+  kernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl", statisticsOptions), "sampleStage")
+                                    : plainKernel_;
+  launchIdentity_ = fmt::format("{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}", device.name(),
+                                device.device.getInfo<CL_DRIVER_VERSION>(),
+                                device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), embeddedSourcesHash(),
+                                plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
   if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
   if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
   sceneBuffers_ = std::move(sceneBuffers);

@@ -60,6 +60,7 @@ class Sampler : public StageSampler {
   StoredSampleBuffer storedSampleBuffer() override { return {storedSampleDevice(), &samples_, nullptr}; }
 
   std::vector<DeviceShare> deviceShares() const override;
+  std::string launchIdentity() const override { return launchIdentity_; }
   int launchGroupSize() const override { return localSize_; }
   int pixelLanes(bool keepsStatistics) const override { return keepsStatistics ? 0 : pixelLanes_; }
 
@@ -82,6 +83,7 @@ class Sampler : public StageSampler {
   cl::Buffer counts_, firstIndex_, pixelOrder_, rgb_, moments_;
   cl::Buffer coefficients_;  // --weights optimal: a_{c,k} per pixel (StagePlan::optimalCoefficients)
   DeviceShare share_;        // since reset()
+  std::string launchIdentity_;
 };
 
 }  // namespace misalloc

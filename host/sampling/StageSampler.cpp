@@ -20,7 +20,7 @@ LaunchWork StageSampler::launchWork(const StagePlan& plan) const {
   return work;
 }
 
-CostModel& StageSampler::costModel() {
+const CostModel& StageSampler::costModel() {
   if (!costModel_) costModel_ = calibrateCostModel(*this);
   return *costModel_;
 }

@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 #include <optional>
+#include <string>
 
 #include "sampling/CostModel.h"
 #include "sampling/DeviceReport.h"
@@ -30,10 +31,13 @@ class StageSampler : public StageStatistics, public DeviceReport {
 
   // What a launch of `plan` executes, as this sampler runs it (LaunchWork.h).
   LaunchWork launchWork(const StagePlan& plan) const;
-  // The model of this sampler's launch times, calibrated at the first call
-  // (calibrateCostModel) and kept, for the renders to refit on their stages: the same
-  // kernels on the same scene.
-  CostModel& costModel();
+  // The model of this sampler's launch times: the one set, else calibrated at the first
+  // call (calibrateCostModel) and kept for every later render, which it predicts.
+  const CostModel& costModel();
+  void setCostModel(CostModel model) { costModel_ = std::move(model); }
+  // What its launch times depend on besides the scene: the devices and the kernels as
+  // built (their source and options). The cost cache's key (render/CostCache.h).
+  virtual std::string launchIdentity() const = 0;
 
   // The pixels that run a technique's loop together: a work-group (Sampler).
   virtual int launchGroupSize() const { return 1; }

@@ -41,6 +41,12 @@ TiledSampler::TiledSampler(const Scene& scene, const SamplerConfig& config,
   forgetStages();
 }
 
+std::string TiledSampler::launchIdentity() const {
+  std::string identity = "tiles over";
+  for (const auto& member : members_) identity += " [" + member->launchIdentity() + "]";
+  return identity;
+}
+
 StageResult TiledSampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
   const int M = scene_.techniqueCount();
   const size_t D = members_.size();

@@ -39,6 +39,8 @@ class TiledSampler : public StageSampler {
   StoredSampleBuffer storedSampleBuffer() override;
 
   std::vector<DeviceShare> deviceShares() const override;
+  // The members', in their order: the tiles' shares follow their speeds.
+  std::string launchIdentity() const override;
   double imbalanceSeconds() const override { return imbalanceSeconds_; }
   // Tiles run on every member at once: work-groups taken as large as the largest.
   int launchGroupSize() const override;

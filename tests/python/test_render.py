@@ -7,8 +7,8 @@ import pytest
 import misalloc
 from conftest import SIZE, rgb
 
-# Given costs: a measured cost model times this run's own launches, and two processes
-# would allocate differently.
+# Given costs, where a test compares renders of caches of their own: a calibration
+# times its own launches, and two calibrations allocate differently.
 COSTS = "1e-9,2e-9"
 SIZE_WORD = f"{SIZE[0]}x{SIZE[1]}"
 
@@ -42,6 +42,21 @@ def test_render_is_the_cli_render_bit_for_bit(cli, tmp_path, cache_dir, method):
         assert np.all(ours.alpha == 0.5)
     else:
         assert ours.alpha.std() > 0.01  # the allocation differs from pixel to pixel
+
+
+def test_default_costs_are_calibrated_once_and_every_render_repeats(cli, tmp_path):
+    cache = tmp_path / "cache"
+    options = dict(method="exact", spp=24, seed=7, reference="none")
+    scene = misalloc.Scene(envmap="venice_sunset", size=SIZE, cache_dir=cache)
+    first = scene.render(**options)
+    again = scene.render(**options)
+    assert first.report["allocation"]["costs_source"] == "calibrated"
+    assert again.report["allocation"]["costs_source"] == "cache"
+    assert np.array_equal(first.image, again.image)
+    # The CLI reads the same cache entry: the same device, kernels and scene.
+    theirs = cli_image(cli, tmp_path, "--envmap", "venice_sunset", "--size", SIZE_WORD, "--cache-dir", cache,
+                       "--method", "exact", "--spp", 24, "--seed", 7)
+    assert np.array_equal(first.image, theirs)
 
 
 def test_gbuffer_as_a_file_and_as_arrays_is_the_cli_render(cli, tmp_path, cache_dir, spheres_gbuffer):
