@@ -234,7 +234,9 @@ TEST_CASE("merge compares the bands' inputs by content and their options by fina
     const std::string scene = input == std::string("gbuffer") ? "--envmap sun --gbuffer g.exr"
                                                               : "--envmap sun --mesh mesh.obj --camera-origin 0,0,3";
     renderBandIn(dir.path, "a", scene, 0, fmt::format("{}0.exr", input));
-    renderBandIn(dir.path, "a", scene, 1, fmt::format("{}1.exr", input));
+    // A text option's numbers in another spelling: the same run.
+    const std::string respelled = input == std::string("gbuffer") ? scene : scene + ".0 --camera-target 0e0,0,0";
+    renderBandIn(dir.path, "a", respelled, 1, fmt::format("{}1.exr", input));
     renderBandIn(dir.path, "same", scene, 2, fmt::format("{}2.exr", input));
     renderBandIn(dir.path, "other", scene, 2, fmt::format("other_{}2.exr", input));
     m = runMisalloc(merged(input, fmt::format("{}2.exr", input)));
