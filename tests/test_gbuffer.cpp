@@ -221,6 +221,53 @@ TEST_CASE("pbrt's camera space reads through its header's worldToCamera", "[gbuf
   CHECK_NOTHROW(readGBuffer(options));
 }
 
+TEST_CASE("an orthographic G-buffer: normals and one view direction, no positions", "[gbuffer]") {
+  TempDir dir("gbuffer_orthographic");
+  // Random normals, every pixel seen along one direction (in the map's frame).
+  TruthScene truth = truthScene();
+  const double length = std::sqrt(0.98);
+  const Vec3d view{0.3 / length, -0.5 / length, 0.8 / length};
+  const Vec3f viewF{float(view[0]), float(view[1]), float(view[2])};
+  for (PixelFrame& f : truth.frames) {
+    if (f.normal[0] * viewF[0] + f.normal[1] * viewF[1] + f.normal[2] * viewF[2] < 0)
+      for (float& x : f.normal) x = -x;
+    f.mirror = mirrorDirection(f.normal, viewF);
+  }
+  for (GBufferConvention c : {GBufferConvention::Misalloc, GBufferConvention::Mitsuba, GBufferConvention::Blender}) {
+    const std::string name = c == GBufferConvention::Misalloc  ? "misalloc"
+                             : c == GBufferConvention::Mitsuba ? "mitsuba"
+                                                               : "blender";
+    INFO(name);
+    const std::string normal = c == GBufferConvention::Misalloc  ? "N"
+                               : c == GBufferConvention::Mitsuba ? "sh_normal"
+                                                                 : "ViewLayer.Normal";
+    Written w = inConvention(truth, c, normal, "unused");
+    w.names.erase(w.names.begin() + 3, w.names.begin() + 6);  // no positions
+    w.planes.erase(w.planes.begin() + 3, w.planes.begin() + 6);
+    const std::string path = (dir.path / (name + ".exr")).string();
+    writeRawChannels(path, kWidth, kHeight, w.names, w.planes);
+    const Vec3d d = inWorld(c, view);
+    GBufferOptions options;
+    options.path = path;
+    options.convention = name;
+    options.viewDirection = fmt::format("{},{},{}", 2 * d[0], 2 * d[1], 2 * d[2]);  // any length
+    checkFrames(readGBuffer(options), truth);
+    options.cameraOrigin = originIn(c);
+    CHECK_THROWS_WITH(readGBuffer(options), Catch::Contains("not both"));
+    options.cameraOrigin.clear();
+    options.viewDirection = "0,0,0";
+    CHECK_THROWS_WITH(readGBuffer(options), Catch::Contains("non-zero length"));
+    options.viewDirection = "1,nan,0";
+    CHECK_THROWS_AS(readGBuffer(options), InputError);
+  }
+  const std::string out = (dir.path / "r.exr").string();
+  auto r = runMisalloc("render --view-direction 0,0,1 --size 8x8 --spp 4 --no-preview --out " + out);
+  INFO(r.output);
+  CHECK(r.exitCode == 2);
+  CHECK(r.output.find("--view-direction: the view of an orthographic G-buffer") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(out));
+}
+
 TEST_CASE("bad G-buffers are refused naming the problem", "[gbuffer][safety]") {
   TempDir dir("gbuffer_bad");
   const TruthScene truth = truthScene();

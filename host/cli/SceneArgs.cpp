@@ -41,6 +41,9 @@ void SceneArgs::add(CLI::App& command) {
                      "the G-buffer's position channels' prefix (PREFIX.X/Y/Z), if not the convention's");
   command.add_option("--camera-origin", options.gbuffer.cameraOrigin,
                      "X,Y,Z: the camera's position in the G-buffer's world (pbrt: from its header)");
+  command.add_option("--view-direction", options.gbuffer.viewDirection,
+                     "X,Y,Z: an orthographic G-buffer's view, towards the camera, in the G-buffer's space (in "
+                     "place of positions and --camera-origin)");
   command.add_option("--mesh", options.mesh.path,
                      "a triangle mesh (OBJ, PLY, ...) instead of --scene, seen by a pinhole camera from "
                      "--camera-origin, in --convention's world");
@@ -85,6 +88,10 @@ SceneOptions SceneArgs::parsed() {
     for (const char* option : {"--view", "--scene"})
       if (app && app->count(option) > 0)
         throw InputError(fmt::format("--gbuffer with {}: the G-buffer sets each pixel's view", option));
+  if (!options.gbuffer.viewDirection.empty() && options.gbuffer.path.empty() && !options.gbuffer.channels)
+    throw InputError(
+        "--view-direction: the view of an orthographic G-buffer (--gbuffer); a built-in scene takes --view, a mesh "
+        "its camera");
   if (!options.mesh.path.empty() && app && app->count("--view") > 0)
     throw InputError("--mesh with --view: the camera (--camera-origin, --camera-target) sets each pixel's view");
   const SceneShape shape = parseSceneShape(options.shape);

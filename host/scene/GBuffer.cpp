@@ -120,7 +120,22 @@ void checkBrdf(const PhongParameters& b, const std::string& path, const std::str
 struct WorldFromFile {
   std::optional<Eigen::Matrix4d> cameraFromWorld;  // camera space; none: world space
   std::optional<Vec> cameraOrigin;                 // world space: where each pixel is seen from
+  std::optional<Vec> viewDirection;                // the file's space: every pixel's view (orthographic)
 };
+
+// --view-direction: a finite direction of non-zero length, in place of a camera origin.
+std::optional<Vec> viewDirectionOf(const GBufferOptions& options) {
+  if (options.viewDirection.empty()) return std::nullopt;
+  if (!options.cameraOrigin.empty())
+    throw InputError(
+        "--view-direction with --camera-origin: an orthographic view (one direction) or a pinhole camera (a "
+        "position), not both");
+  const auto d = parseNumberList("--view-direction", options.viewDirection, options.viewDirection, 3, "expected X,Y,Z");
+  const Vec direction(d[0], d[1], d[2]);
+  if (!(direction.norm() > 0))
+    throw InputError(fmt::format("--view-direction {}: a direction needs a non-zero length", options.viewDirection));
+  return direction;
+}
 
 WorldFromFile worldFromFile(GBufferConvention convention, const GBufferOptions& options, const ExrHeader& header) {
   const std::string space =
@@ -133,6 +148,7 @@ WorldFromFile worldFromFile(GBufferConvention convention, const GBufferOptions& 
     for (int i = 0; i < 16; ++i) (*matrix)(i / 4, i % 4) = it->second[size_t(i)];
   }
   WorldFromFile out;
+  out.viewDirection = viewDirectionOf(options);
   if (space == "camera") {
     if (convention != GBufferConvention::Pbrt)
       throw InputError("--gbuffer-space camera: only pbrt-v4 writes camera space (its header's worldToCamera)");
@@ -147,6 +163,7 @@ WorldFromFile worldFromFile(GBufferConvention convention, const GBufferOptions& 
     out.cameraFromWorld = matrix;
     return out;
   }
+  if (out.viewDirection) return out;
   if (!options.cameraOrigin.empty()) {
     const auto o = parseNumberList("--camera-origin", options.cameraOrigin, options.cameraOrigin, 3, "expected X,Y,Z");
     out.cameraOrigin = Vec(o[0], o[1], o[2]);
@@ -155,7 +172,8 @@ WorldFromFile worldFromFile(GBufferConvention convention, const GBufferOptions& 
   } else {
     throw InputError(
         fmt::format("--gbuffer {} with --convention {}: each pixel's view needs --camera-origin X,Y,Z "
-                    "(the camera's position in the G-buffer's world)",
+                    "(the camera's position in the G-buffer's world) or, for an orthographic view, "
+                    "--view-direction X,Y,Z",
                     options.path, options.convention));
   }
   return out;
@@ -198,15 +216,21 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   const std::vector<std::string> normalNames = xyz(prefixes.normal), viewNames = xyz("view");
   const bool hasView =
       std::all_of(viewNames.begin(), viewNames.end(), [&](const std::string& c) { return hasChannel(header, c); });
-  const std::vector<std::string> positionNames = hasView ? viewNames : xyz(prefixes.position);
+  if (hasView && !options.viewDirection.empty())
+    throw InputError(
+        fmt::format("--view-direction: '{}' has view channels, which give each pixel's view", options.path));
+  const WorldFromFile world = hasView ? WorldFromFile{} : worldFromFile(convention, options, header);
+  // The view channels are read in the positions' place; an orthographic view needs neither.
+  const std::vector<std::string> positionNames =
+      hasView ? viewNames : (world.viewDirection ? std::vector<std::string>{} : xyz(prefixes.position));
   requireChannels(header, normalNames, options.path, "--normal-channels");
   requireChannels(header, positionNames, options.path, "--position-channels");
-  const WorldFromFile world = hasView ? WorldFromFile{} : worldFromFile(convention, options, header);
   std::vector<std::string> names = normalNames;
   names.insert(names.end(), positionNames.begin(), positionNames.end());
   const bool hasAlpha = hasChannel(header, "A"), hasBrdf = hasBrdfChannels(header, options.path);
   const std::vector<std::string> uvNames =
       hasBrdf ? std::vector<std::string>{} : uvChannels(convention, prefixes, header);
+  const size_t alphaPlane = names.size();
   if (hasAlpha) names.push_back("A");
   const size_t brdfPlane = names.size();
   if (hasBrdf) names.insert(names.end(), kBrdfChannels.begin(), kBrdfChannels.end());
@@ -229,8 +253,9 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
     out.uv.push_back({std::isfinite(u) ? u - std::floor(u) : 0.0, std::isfinite(v) ? v - std::floor(v) : 0.0});
   }
   for (size_t p = 0; p < pixels; ++p) {
-    const Vec n(planes[0][p], planes[1][p], planes[2][p]), position(planes[3][p], planes[4][p], planes[5][p]);
-    if (hasAlpha && !(planes[6][p] > 0)) continue;
+    const Vec n(planes[0][p], planes[1][p], planes[2][p]);
+    const Vec position = positionNames.empty() ? Vec::Zero() : Vec(planes[3][p], planes[4][p], planes[5][p]);
+    if (hasAlpha && !(planes[alphaPlane][p] > 0)) continue;
     if (n.x() == 0 && n.y() == 0 && n.z() == 0) continue;
     if (!n.allFinite() || !position.allFinite())
       throw InputError(fmt::format("'{}': the covered pixel at {} has a NaN or infinite normal or position",
@@ -243,7 +268,10 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
       // Normals by the inverse transpose of camera-from-world's inverse: its transpose.
       const Eigen::Matrix3d m = world.cameraFromWorld->topLeftCorner<3, 3>();
       normal = m.transpose() * n;
-      view = m.inverse() * (-position);
+      view = m.inverse() * (world.viewDirection ? *world.viewDirection : Vec(-position));
+    } else if (world.viewDirection) {
+      normal = n;
+      view = *world.viewDirection;
     } else {
       normal = n;
       view = *world.cameraOrigin - position;

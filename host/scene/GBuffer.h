@@ -49,6 +49,9 @@ struct GBufferOptions {
   // the world. The others write world space.
   std::string space;
   std::shared_ptr<const ChannelImage> channels;  // the G-buffer in memory instead of the file at `path`
+  // "X,Y,Z" in the file's space: an orthographic view, every pixel seen from this
+  // direction (towards the camera), in place of positions and a camera origin.
+  std::string viewDirection;
 };
 
 struct GBufferImage {
@@ -64,8 +67,9 @@ struct GBufferImage {
 
 // Each pixel's frame (normal turned to face its view, the mirror direction of the view)
 // and coverage; the view from the channels view.X, .Y, .Z (towards the camera) where the
-// file has them, which then needs neither positions nor a camera; else from the position
-// to the camera. Coverage: the alpha channel A where the file has one (> 0: covered), and a zero
+// file has them, or the one direction of an orthographic view (viewDirection), either
+// of which then needs neither positions nor a camera; else from the position to the
+// camera. Coverage: the alpha channel A where the file has one (> 0: covered), and a zero
 // normal marks the background too. Throws InputError before any work on: a missing
 // channel (naming those looked for and those found), a NaN or infinite normal or
 // position on a covered pixel, a camera origin missing where the convention needs one or
