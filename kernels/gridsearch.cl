@@ -336,18 +336,19 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
 // back or skipped), the fallback and skip flags, and V(equal)/V(selected) as the window
 // predicts it (pooledVarianceRatio; 1 where the pixel skipped or kept its own α).
 __kernel void selectPooled(__global const float* scores, __global const float* scales, __global const float* alpha,
-                           __global const int* selected, __global const uint* fallbacks, int width, int height,
-                           int radius, __global const float* gridLanes, __global const float* gridCost, int gridSize,
-                           int paddedSize, int equal, float minGain, __global float* alphaOut,
-                           __global int* selectedOut, __global uint* fallbacksOut, __global uchar* skippedOut,
-                           __global float* varianceRatioOut) {
+                           __global const int* selected, __global const uint* fallbacks, __global const int* surfaces,
+                           int width, int height, int radius, __global const float* gridLanes,
+                           __global const float* gridCost, int gridSize, int paddedSize, int equal, float minGain,
+                           __global float* alphaOut, __global int* selectedOut, __global uint* fallbacksOut,
+                           __global uchar* skippedOut, __global float* varianceRatioOut) {
   int pixel = (int)get_global_id(0);
   if (pixel >= width * height) return;
-  PoolWindow w = poolWindow(pixel, width, height, radius);
+  PoolWindow w = poolWindow(pixel, width, height, radius, surfaces[pixel]);
   float scaleMin = INFINITY;
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x)
-      if (pools(w, y * width + x, fallbacks[y * width + x])) scaleMin = fmin(scaleMin, scales[y * width + x]);
+      if (pools(w, y * width + x, fallbacks[y * width + x], surfaces[y * width + x]))
+        scaleMin = fmin(scaleMin, scales[y * width + x]);
   int best = -1, skipped = 0;
   float ratio = 1.0f;
   if (scaleMin < INFINITY) {
@@ -365,7 +366,7 @@ __kernel void selectPooled(__global const float* scores, __global const float* s
       for (int y = w.y0; y <= w.y1; ++y)
         for (int x = w.x0; x <= w.x1; ++x) {
           int q = y * width + x;
-          if (!pools(w, q, fallbacks[q])) continue;
+          if (!pools(w, q, fallbacks[q], surfaces[q])) continue;
           float16 factor = (float16)poolingFactor(scaleMin, scales[q]);
           __global const float* s = scores + (size_t)q * paddedSize + l0;
           MA_UNROLL
@@ -384,7 +385,7 @@ __kernel void selectPooled(__global const float* scores, __global const float* s
     for (int y = w.y0; y <= w.y1; ++y)
       for (int x = w.x0; x <= w.x1; ++x) {
         int q = y * width + x;
-        if (!pools(w, q, fallbacks[q])) continue;
+        if (!pools(w, q, fallbacks[q], surfaces[q])) continue;
         __global const float* s = scores + (size_t)q * paddedSize;
         float d = (s[best] - s[equal]) * poolingFactor(scaleMin, scales[q]);
         sumD += d;

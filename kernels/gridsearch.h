@@ -373,16 +373,18 @@ MA_FN float poolingFactor(float scaleMin, float scale) {
   return r * r;
 }
 
-// The window of radius r around pixel (x, y), clipped at the image's edges. For r > 0
-// it leaves the pixel itself out: its α and its pilot's weight then come from its
-// neighbours' samples only, so that the weight is independent of the pilot it weighs
-// (host/alloc/StageWeights.h, pilotWeight).
+// The window of radius r around pixel (x, y), clipped at the image's edges, over the
+// pixels of its surface (host/scene/Surfaces.h). For r > 0 it leaves the pixel itself
+// out: its α and its pilot's weight then come from its neighbours' samples only, so
+// that the weight is independent of the pilot it weighs (host/alloc/StageWeights.h,
+// pilotWeight).
 typedef struct {
   int x0, x1, y0, y1;
-  int self;  // the pixel left out, −1 for none
+  int self;     // the pixel left out, −1 for none
+  int surface;  // the pixel's surface: only its pixels pool
 } PoolWindow;
 
-MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius) {
+MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius, int surface) {
   PoolWindow w;
   int x = pixel % width, y = pixel / width;
   w.x0 = x - radius < 0 ? 0 : x - radius;
@@ -390,11 +392,15 @@ MA_FN PoolWindow poolWindow(int pixel, int width, int height, int radius) {
   w.y0 = y - radius < 0 ? 0 : y - radius;
   w.y1 = y + radius > height - 1 ? height - 1 : y + radius;
   w.self = radius > 0 ? pixel : -1;
+  w.surface = surface;
   return w;
 }
 
-// Whether pixel q of window w, with fallback bits `fallback`, enters the pooled sums.
-MA_FN int pools(PoolWindow w, int q, ma_uint fallback) { return q != w.self && fallback == 0u; }
+// Whether pixel q of window w, of surface `surface` and with fallback bits `fallback`,
+// enters the pooled sums.
+MA_FN int pools(PoolWindow w, int q, ma_uint fallback, int surface) {
+  return q != w.self && fallback == 0u && surface == w.surface;
+}
 
 // V(equal)/V(selected), the variances (not cost × variance) that the pooled scores
 // (≤ 0) predict, from those scores and the costs per sample of the two combinations;

@@ -14,6 +14,7 @@
 #include "sampling/HostSampler.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
+#include "scene/Surfaces.h"
 
 namespace misalloc::test {
 
@@ -70,11 +71,13 @@ inline void giveRandomFrames(Scene& scene, uint32_t key) {
     }
     scene.geometry.pixels[size_t(p)] = frameSeenFrom(n, v);
   }
+  scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
 }
 
 // Every `period`-th pixel, from pixel 1, made background (SceneGeometry::covered).
 inline void giveBackground(Scene& scene, int period) {
   for (size_t p = 1; p < scene.geometry.covered.size(); p += size_t(period)) scene.geometry.covered[p] = 0;
+  scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
 }
 
 // The sampler of the statistical sweeps: the C++ reference, which computes the kernel's

@@ -18,6 +18,10 @@ namespace misalloc {
 
 static_assert(MA_GRID_MAX_TECHNIQUES == kMaxTechniques);
 
+std::vector<int32_t> PooledSelection::surfaceOfPixels() const {
+  return surfaces.empty() ? std::vector<int32_t>(std::size_t(width) * std::size_t(height), 0) : surfaces;
+}
+
 namespace {
 
 // B, the float16s of weight combinations that share one pass over a pixel's samples
@@ -47,8 +51,8 @@ void checkColumns(SampleColumns columns, bool optimalWeights) {
 
 void checkLayout(const StoredSampleLayout& layout, SampleColumns columns, int pixelCount, std::size_t availableFloats) {
   if (layout.columns != columns.count())
-    throw std::invalid_argument(fmt::format("grid search: samples of {} columns, search built for {}",
-                                            layout.columns, columns.count()));
+    throw std::invalid_argument(
+        fmt::format("grid search: samples of {} columns, search built for {}", layout.columns, columns.count()));
   if (layout.pixelCount != pixelCount)
     throw std::invalid_argument(
         fmt::format("grid search: samples of {} pixels, search built for {}", layout.pixelCount, pixelCount));
@@ -139,7 +143,8 @@ void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, 
   if (!pooling) return;
   if (rule == GridRule::MaxEntropy) throw std::invalid_argument("grid search: rule (a) cannot pool its selection");
   if (std::size_t(pooling->width) * std::size_t(std::max(0, pooling->height)) != std::size_t(pixelCount) ||
-      pooling->radius < 0 || !(pooling->minGain >= 0 && pooling->minGain < 1))
+      pooling->radius < 0 || !(pooling->minGain >= 0 && pooling->minGain < 1) ||
+      !(pooling->surfaces.empty() || pooling->surfaces.size() == std::size_t(pixelCount)))
     throw std::invalid_argument(fmt::format("grid search: pooling over {}x{} pixels, radius {}, gain {} for {} pixels",
                                             pooling->width, pooling->height, pooling->radius, pooling->minGain,
                                             pixelCount));
@@ -377,13 +382,13 @@ void searchPixel(const SearchSetup& setup, int pixel, std::vector<float>& prepar
 // over the window's pooled pixels q in row-major order, one fma chain, as a lane of the
 // kernel selectPooled sums it.
 float pooledScore(const std::vector<float>& scores, const std::vector<float>& scales,
-                  const std::vector<unsigned>& fallbacks, kern::PoolWindow w, int width, int paddedSize, float scaleMin,
-                  int l) {
+                  const std::vector<unsigned>& fallbacks, const std::vector<int32_t>& surfaces, kern::PoolWindow w,
+                  int width, int paddedSize, float scaleMin, int l) {
   float sum = 0.0f;
   for (int y = w.y0; y <= w.y1; ++y)
     for (int x = w.x0; x <= w.x1; ++x) {
       int q = y * width + x;
-      if (kern::pools(w, q, fallbacks[q]))
+      if (kern::pools(w, q, fallbacks[q], surfaces[q]))
         sum = std::fma(scores[std::size_t(q) * paddedSize + l], kern::poolingFactor(scaleMin, scales[q]), sum);
     }
   return sum;
@@ -391,36 +396,37 @@ float pooledScore(const std::vector<float>& scores, const std::vector<float>& sc
 
 // The kernel selectPooled for one pixel, with the combinations in a plain loop: each
 // combination's pooled score is the same fma chain as the kernel's lane.
-void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling, int equal,
-                       const std::vector<float>& scores, const std::vector<float>& scales, const SelectionArrays& in,
-                       int pixel, SelectionArrays& out) {
+void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling, const std::vector<int32_t>& surfaces,
+                       int equal, const std::vector<float>& scores, const std::vector<float>& scales,
+                       const SelectionArrays& in, int pixel, SelectionArrays& out) {
   const int m = setup.layout.columns, padded = setup.lanes.paddedSize;
-  kern::PoolWindow w = kern::poolWindow(pixel, pooling.width, pooling.height, pooling.radius);
+  kern::PoolWindow w = kern::poolWindow(pixel, pooling.width, pooling.height, pooling.radius, surfaces[pixel]);
   float scaleMin = INFINITY;
   for (int y = w.y0; y <= w.y1; ++y)
-    for (int x = w.x0; x <= w.x1; ++x)
-      if (kern::pools(w, y * pooling.width + x, in.fallbacks[y * pooling.width + x]))
-        scaleMin = std::fmin(scaleMin, scales[y * pooling.width + x]);
+    for (int x = w.x0; x <= w.x1; ++x) {
+      const int q = y * pooling.width + x;
+      if (kern::pools(w, q, in.fallbacks[q], surfaces[q])) scaleMin = std::fmin(scaleMin, scales[q]);
+    }
   int best = -1, skipped = 0;
   float ratio = 1.0f;
   if (scaleMin < INFINITY) {
     float top = -INFINITY;
     for (int l = 0; l < setup.grid.size(); ++l) {
-      float score = pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, l);
+      float score = pooledScore(scores, scales, in.fallbacks, surfaces, w, pooling.width, padded, scaleMin, l);
       if (score > top) top = score, best = l;
     }
     float sumD = 0.0f, sumD2 = 0.0f, count = 0.0f;
     for (int y = w.y0; y <= w.y1; ++y)
       for (int x = w.x0; x <= w.x1; ++x) {
         int q = y * pooling.width + x;
-        if (!kern::pools(w, q, in.fallbacks[q])) continue;
+        if (!kern::pools(w, q, in.fallbacks[q], surfaces[q])) continue;
         const float* s = scores.data() + std::size_t(q) * padded;
         float d = (s[best] - s[equal]) * kern::poolingFactor(scaleMin, scales[q]);
         sumD += d;
         sumD2 = std::fma(d, d, sumD2);
         count += 1.0f;
       }
-    float pooledEqual = pooledScore(scores, scales, in.fallbacks, w, pooling.width, padded, scaleMin, equal);
+    float pooledEqual = pooledScore(scores, scales, in.fallbacks, surfaces, w, pooling.width, padded, scaleMin, equal);
     skipped = kern::skipsAdapting(top, pooledEqual, float(pooling.minGain), sumD, sumD2, count);
     if (!skipped && w.self >= 0)
       ratio = kern::pooledVarianceRatio(top, setup.lanes.cost[best], pooledEqual, setup.lanes.cost[equal]);
@@ -476,9 +482,10 @@ WeightGrid makeWeightGrid(SampleColumns columns, int approximateSize, const std:
 }
 
 std::string gridSearchKernelOptions(SampleColumns columns, bool optimalWeights) {
-  return fmt::format("-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SHARE_COLUMNS={} -DMA_GRID_VECTORS={} "
-                     "-DMA_GRID_OPTIMAL_WEIGHTS={}",
-                     columns.count(), columns.shareColumns, kGridVectors, optimalWeights ? 1 : 0);
+  return fmt::format(
+      "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SHARE_COLUMNS={} -DMA_GRID_VECTORS={} "
+      "-DMA_GRID_OPTIMAL_WEIGHTS={}",
+      columns.count(), columns.shareColumns, kGridVectors, optimalWeights ? 1 : 0);
 }
 
 std::size_t gridSearchBytesPerPixel(SampleColumns columns, int gridSize, bool runningSums, bool optimalWeights) {
@@ -523,7 +530,8 @@ GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCou
   // with a search of no samples, not inside the first timed one.
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
   run(noSamples, StoredSampleLayout{pixelCount, columns.count(), 0, 0},
-      std::vector<double>(columns.techniqueCount, 1.0), GridRule::MinCostVariance, PooledSelection{pixelCount, 1, 0, 0});
+      std::vector<double>(columns.techniqueCount, 1.0), GridRule::MinCostVariance,
+      PooledSelection{pixelCount, 1, 0, 0});
 }
 
 void GridSearch::reset() {
@@ -581,10 +589,13 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
     cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
     cl::Buffer ratioOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(float));
-    bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, cl_int(pooling->width),
-                   cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost, cl_int(grid.size()),
-                   cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)), cl_float(pooling->minGain), alphaFinal,
-                   selectedFinal, fallbacksFinal, skippedOut, ratioOut);
+    std::vector<int32_t> surfaces = pooling->surfaceOfPixels();
+    cl::Buffer surfaceBuffer(device_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                             surfaces.size() * sizeof(int32_t), surfaces.data());
+    bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, surfaceBuffer,
+                   cl_int(pooling->width), cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost,
+                   cl_int(grid.size()), cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)),
+                   cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut);
     cl::Event pooled;
     device_.queue.enqueueNDRangeKernel(
         poolKernel_, cl::NullRange,
@@ -664,9 +675,10 @@ GridSearchResult GridSearchReference::run(const std::vector<float>& samples, con
   SelectionArrays selection = searched;
   if (pooling) {
     const int equal = nearestEqual(grid);
+    const std::vector<int32_t> surfaces = pooling->surfaceOfPixels();
 #pragma omp parallel for schedule(dynamic, 64)
     for (int pixel = 0; pixel < pixels; ++pixel)
-      selectPooledPixel(setup, *pooling, equal, scores, scales, searched, pixel, selection);
+      selectPooledPixel(setup, *pooling, surfaces, equal, scores, scales, searched, pixel, selection);
   }
   GridSearchResult result = toResult(selection, columns_);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -6,6 +6,7 @@
 
 #include <CL/opencl.hpp>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,6 +79,12 @@ struct PooledSelection {
   int width = 0, height = 0;
   int radius = 0;
   double minGain = 0;
+  // Per pixel, its surface (Scene::surfaces): a window pools over its pixel's surface
+  // only. Empty: one surface.
+  std::vector<int32_t> surfaces;
+
+  // `surfaces`, or one surface for every pixel where empty.
+  std::vector<int32_t> surfaceOfPixels() const;
 };
 
 struct GridSearchResult {

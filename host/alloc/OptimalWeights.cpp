@@ -100,7 +100,7 @@ StageCoefficients optimalCoefficients(StageStatistics& stages, int poolRadius, c
   const Scene& scene = stages.scene();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = stages.statSlots();
   std::vector<double> stats = stages.statistics();
-  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius);
+  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius, scene.surfaces);
   StageCoefficients out{std::vector<float>(size_t(pixels) * 3 * M), std::vector<unsigned char>(pixels)};
 #pragma omp parallel for schedule(dynamic, 256)
   for (int p = 0; p < pixels; ++p) {
@@ -153,7 +153,7 @@ StageCoefficients retargetedCoefficients(StageStatistics& stages, const StagePla
   if (stored.stageSamples > capacity) throw std::logic_error("retargetedCoefficients: the stage was not stored whole");
   const std::vector<float> samples = stages.storedSamples();
   std::vector<double> stats = stages.statistics();
-  poolNeighbourhood(stats, width, height, slots, poolRadius);
+  poolNeighbourhood(stats, width, height, slots, poolRadius, scene.surfaces);
   StageCoefficients out{std::vector<float>(size_t(pixels) * 3 * M), std::vector<unsigned char>(pixels)};
 #pragma omp parallel for schedule(dynamic, 64)
   for (int p = 0; p < pixels; ++p) {

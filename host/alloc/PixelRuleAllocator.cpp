@@ -32,7 +32,7 @@ StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages, const std:
   const SamplerConfig& config = stages.config();
   const int pixels = scene.pixelCount(), M = scene.techniqueCount(), slots = stages.statSlots();
   std::vector<double> stats = stages.statistics();
-  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius_);
+  poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius_, scene.surfaces);
   const std::vector<float> stored = rule_ == PixelRule::Linear ? stages.storedSamples() : std::vector<float>{};
   const int taken = stages.samplesTaken();
   StageAllocation out{std::vector<Allocation>(pixels), std::vector<float>(pixels, 1.0f),

@@ -15,14 +15,17 @@
 // (GridSearch.h, PooledSelection). The two share only the window's shape, (2r + 1)²
 // pixels clipped at the image's edges.
 
+#include <cstdint>
 #include <vector>
 
 namespace misalloc {
 
 // Replaces each pixel's `channels` values ([pixel · channels + c], row-major pixels of a
 // width × height image) by their sums over the (2·radius + 1)² pixels around it,
-// clipped at the image's edges. Sums are taken directly, not as running differences,
-// which would lose a dim pixel's values beside a million times brighter one.
-void poolNeighbourhood(std::vector<double>& values, int width, int height, int channels, int radius);
+// clipped at the image's edges, of its own surface (`surfaces`, Scene::surfaces; empty:
+// one surface). Sums are taken directly, not as running differences, which would lose
+// a dim pixel's values beside a million times brighter one.
+void poolNeighbourhood(std::vector<double>& values, int width, int height, int channels, int radius,
+                       const std::vector<int32_t>& surfaces);
 
 }  // namespace misalloc

@@ -56,6 +56,7 @@ Scene bandScene(Scene image, RowRange rows) {
   image.grid.pixels = rowsOf(image.grid.pixels, width, 0, rows);
   image.geometry.pixels = rowsOf(image.geometry.pixels, width, 0, rows);
   image.geometry.covered = rowsOf(image.geometry.covered, width, 0, rows);
+  image.surfaces = rowsOf(image.surfaces, width, 0, rows);
   image.options.height = rows.size();
   if (image.tables.hasBank()) image.tables.brdfBinOfPixel = rowsOf(image.tables.brdfBinOfPixel, width, 0, rows);
   // Its tables now map the band's pixels only: never cached under the image's key.

@@ -219,11 +219,11 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   if (hasView && !options.viewDirection.empty())
     throw InputError(
         fmt::format("--view-direction: '{}' has view channels, which give each pixel's view", options.path));
+  requireChannels(header, normalNames, options.path, "--normal-channels");
   const WorldFromFile world = hasView ? WorldFromFile{} : worldFromFile(convention, options, header);
   // The view channels are read in the positions' place; an orthographic view needs neither.
   const std::vector<std::string> positionNames =
       hasView ? viewNames : (world.viewDirection ? std::vector<std::string>{} : xyz(prefixes.position));
-  requireChannels(header, normalNames, options.path, "--normal-channels");
   requireChannels(header, positionNames, options.path, "--position-channels");
   std::vector<std::string> names = normalNames;
   names.insert(names.end(), positionNames.begin(), positionNames.end());

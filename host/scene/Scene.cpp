@@ -12,6 +12,7 @@
 #include "KernelCode.h"
 #include "distributions/BankCache.h"
 #include "scene/SceneShape.h"
+#include "scene/Surfaces.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
@@ -121,6 +122,7 @@ Scene makeScene(const SceneOptions& options) {
     scene.grid = makeBrdfGrid(options.grid, options.width, options.height, shape.uv);
     scene.geometry = std::move(shape.geometry);
   }
+  scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
   if (options.envmapTexels) {
     scene.envmap = envmapFromTexels(*options.envmapTexels, options.envmap, &scene.envmapWarnings);
   } else {

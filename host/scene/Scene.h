@@ -1,5 +1,6 @@
 #pragma once
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,7 +58,10 @@ struct Scene {
   EnvmapTables tables;
   ProductTables productTables;  // --product; none otherwise
   BrdfGrid grid;
-  SceneGeometry geometry;       // each pixel's normal and mirror direction
+  SceneGeometry geometry;  // each pixel's normal and mirror direction
+  // Per pixel, the surface it shows (labelSurfaces): the pooled allocations pool within
+  // one. Labelled on the whole image, so that a band's rows keep the image's labels.
+  std::vector<int32_t> surfaces;
   ReadWarnings envmapWarnings;  // negative texels set to 0 on reading
   std::string bankCacheKey;     // where the optimal pdf's tables were looked up in SceneOptions::bankCacheDir
   // The image's index of pixel 0: 0 for a whole image; a band of an image's rows
