@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -25,6 +26,18 @@ void addSized(BiasFamily& family, const std::string& what, double expected, int 
   const int spp = int(std::clamp<long long>(wanted, minSpp, 256LL * pilotSpp));
   const MeanAndError r = render(spp, seed + 0x9e3779b97f4a7c15ull);
   family.add(fmt::format("{}, {} spp", what, spp), r.mean, expected, r.standardError);
+}
+
+// A test of an estimate against a closed form.
+inline void addEstimate(BiasFamily& family, const std::string& what, const MeanAndError& estimate, double expected) {
+  family.add(what, estimate.mean, expected, estimate.standardError);
+}
+
+// A test of an estimate against another, independent one where there is no closed form:
+// their difference has the errors of both.
+inline void addAgreement(BiasFamily& family, const std::string& what, const MeanAndError& estimate,
+                         const MeanAndError& reference) {
+  family.add(what, estimate.mean, reference.mean, std::hypot(estimate.standardError, reference.standardError));
 }
 
 // One failed check per biased or underpowered test, each with its numbers.

@@ -108,9 +108,6 @@ inline MeanAndError pixelMean(const std::vector<double>& rgb) {
   return {mean, std::sqrt(std::max(variance, 0.0) / n)};
 }
 
-// |z| < 4: a false alarm has probability 6e-5 per check for a correct estimator.
-constexpr double kMaxZ = 4.0;
-
 // A zero-variance estimator (f ∝ p) still carries float rounding: each sample's
 // f/(N p) is a float, ~1e-7 relative. The error it is measured against has that floor.
 inline double zScore(double mean, double expected, double standardError) {

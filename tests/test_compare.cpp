@@ -1,6 +1,6 @@
 // misalloc compare: the equal-time arithmetic on curves with known answers, the
-// reductions over repeats, and the command end to end: its files, its bad input and
-// its interruption.
+// reductions over repeats, and the command end to end: its files (the pictures decoded,
+// the page parsed), its bad input and its interruption.
 #include <fmt/format.h>
 #include <signal.h>
 #include <spawn.h>
@@ -16,16 +16,19 @@
 #include <thread>
 
 #include "CliRunner.h"
+#include "PictureChecks.h"
 #include "RunRecords.h"
+#include "compare/Comparison.h"
 #include "compare/ErrorCurve.h"
 #include "compare/ErrorTimePlot.h"
 #include "compare/Summary.h"
 #include "compare/SummaryTables.h"
+#include "report/AlphaMap.h"
+#include "report/PreviewPng.h"
+#include "scene/ExrIO.h"
 
 using namespace misalloc;
-using misalloc::test::record;
-using misalloc::test::runMisalloc;
-using misalloc::test::TempDir;
+using namespace misalloc::test;
 namespace fs = std::filesystem;
 
 namespace {
@@ -35,6 +38,100 @@ ErrorCurve monteCarloCurve(double a, std::vector<double> times) {
   std::vector<CurvePoint> points;
   for (double t : times) points.push_back({t, a / t});
   return ErrorCurve(points);
+}
+
+// A case's repeat-0 pictures against its EXRs and runs.json: every preview drawn from its
+// image at one exposure (the reference's), every α map holding its run's mean α and drawn
+// from its envmap plane. Returns the α maps seen.
+int checkCasePictures(const fs::path& out, const nlohmann::json& info, const nlohmann::json& runs, int size) {
+  const std::string label = info["label"];
+  const auto techniques = info["techniques"].get<std::vector<std::string>>();
+  INFO(label);
+  const Picture reference = readPng(out / label / "reference.png");
+  CHECK(reference.width == size);
+  CHECK(reference.height == size);
+  ExposureRange exposure;
+  int alphaMaps = 0;
+  for (const auto& run : runs) {
+    if (run["case"] != label || run["repeat"] != 0) continue;
+    const Method method = parseMethod(run["method"]);
+    const int spp = run["spp"];
+    INFO(methodName(method) << " " << spp << " spp");
+    const std::string exr = (out / imagePath(label, method, spp)).string();
+    const RgbImage image = readExr(exr);
+    REQUIRE(image.width == size);
+    REQUIRE(image.height == size);
+    narrowExposure(exposure, readPng(previewPath(exr)), image);
+    const std::string alphaMap = (out / alphaMapPath(label, method, spp)).string();
+    CHECK(fs::exists(alphaMap) == isAdaptive(method));
+    if (!isAdaptive(method)) continue;
+    ++alphaMaps;
+    const auto planes = readAlphaMap(alphaMap, techniques, size, size);
+    const AlphaSummary alpha = summarizeAlpha(planes, image);
+    CHECK(alpha.offSimplex == 0);
+    for (size_t k = 0; k < techniques.size(); ++k)
+      CHECK(alpha.coveredMean[k] == Approx(run["mean_alpha"][k].get<double>()).margin(1e-6));
+    CHECK(alphaPictureMismatches(readPng(alphaPngPath(alphaMap)), planes.front(), image) == 0);
+  }
+  INFO("exposures " << exposure.lo << " to " << exposure.hi);
+  CHECK_FALSE(exposure.empty());
+  return alphaMaps;
+}
+
+// The cells' text of the first table after `heading` in a page of html(TextTable) tables,
+// row by row, the header first, bold dropped.
+std::vector<std::vector<std::string>> tableAfter(const std::string& page, const std::string& heading) {
+  const size_t at = page.find(heading);
+  INFO(heading);
+  REQUIRE(at != std::string::npos);
+  const size_t begin = page.find("<table>", at), end = page.find("</table>", begin);
+  REQUIRE(end != std::string::npos);
+  const std::string table = page.substr(begin, end - begin);
+  static const std::regex row("<tr>(.*)</tr>"), cell("<t[hd]>(?:<b>)?(.*?)(?:</b>)?</t[hd]>");
+  std::vector<std::vector<std::string>> rows;
+  for (auto r = std::sregex_iterator(table.begin(), table.end(), row); r != std::sregex_iterator(); ++r) {
+    const std::string cells = (*r)[1];
+    rows.emplace_back();
+    for (auto c = std::sregex_iterator(cells.begin(), cells.end(), cell); c != std::sregex_iterator(); ++c)
+      rows.back().push_back((*c)[1]);
+  }
+  return rows;
+}
+
+std::vector<double> numbersIn(const std::string& text) {
+  static const std::regex number("[0-9]+(\\.[0-9]+)?");
+  std::vector<double> out;
+  for (auto n = std::sregex_iterator(text.begin(), text.end(), number); n != std::sregex_iterator(); ++n)
+    out.push_back(std::stod((*n)[0]));
+  return out;
+}
+
+// A table of rows = methods and columns = cases (SummaryTables.h) against summary.json:
+// each cell holds `fields` of its method's entry at the table budget, rounded to `step`,
+// or "–" where there is none.
+template <typename Fields>  // std::vector<double>(const nlohmann::json& budgetEntry)
+void checkMethodTable(const std::vector<std::vector<std::string>>& table, const nlohmann::json& summary, double step,
+                      Fields fields) {
+  REQUIRE(table.size() == 1 + summary["methods"].size());
+  REQUIRE(table[0].size() == 1 + summary["cases"].size());
+  for (size_t c = 0; c < summary["cases"].size(); ++c) {
+    const nlohmann::json& scene = summary["cases"][c];
+    CHECK(table[0][1 + c] == scene["label"]);
+    for (size_t m = 0; m < summary["methods"].size(); ++m) {
+      const std::string& text = table[1 + m][1 + c];
+      INFO(scene["label"] << " " << summary["methods"][m] << ": " << text);
+      CHECK(table[1 + m][0] == summary["methods"][m]);
+      std::vector<double> expected;
+      for (const auto& method : scene["methods"])
+        if (method["method"] == summary["methods"][m])
+          for (const auto& budget : method["budgets"])
+            if (budget["spp"] == summary["table_spp"]) expected = fields(budget);
+      const std::vector<double> shown = numbersIn(text);
+      REQUIRE(shown.size() == expected.size());
+      for (size_t i = 0; i < shown.size(); ++i) CHECK(std::abs(shown[i] - expected[i]) <= 0.5 * step + 1e-12);
+      if (expected.empty()) CHECK(text == "–");
+    }
+  }
 }
 
 }  // namespace
@@ -160,14 +257,31 @@ TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][comp
     CHECK(m["budgets"].size() == 2);
     CHECK(m["equal_time_rmse_x1000"].size() == 2);
   }
-  // Every file the page shows is in the folder.
+  // The pictures show what the EXRs and runs.json hold: two adaptive methods × two budgets per pdf.
+  for (const auto& info : runs["cases"]) CHECK(checkCasePictures(out, info, runs["runs"], 8) == 2 * 2);
+  // Every file the page shows or links is in the folder, by a relative path.
   std::ifstream in(out / "index.html");
-  std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::regex src("src=\"([^\"]+)\"");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::regex link("(src|href)=\"([^\"]+)\"");
   int images = 0;
-  for (auto it = std::sregex_iterator(html.begin(), html.end(), src); it != std::sregex_iterator(); ++it, ++images)
-    CHECK(fs::exists(out / (*it)[1].str()));
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), link); it != std::sregex_iterator(); ++it) {
+    const std::string path = (*it)[2];
+    INFO(path);
+    CHECK(fs::exists(out / path));
+    CHECK(fs::path(path).is_relative());
+    CHECK(path.find("..") == std::string::npos);
+    images += (*it)[1] == "src";
+  }
   CHECK(images == 1 + 2 * (1 + 4 * 2 + 2));  // plot; per pdf: reference, each method × budget, two α maps
+  // It names every case and method, and its tables' numbers are summary.json's.
+  for (const auto& info : runs["cases"])
+    CHECK(html.find(fmt::format("id=\"{}\"", info["label"].get<std::string>())) != std::string::npos);
+  checkMethodTable(tableAfter(html, "<h2>RMSE×1000 at 20 spp"), summary, 0.01, [](const nlohmann::json& b) {
+    return std::vector<double>{b["rmse_x1000"], b["rmse_spread_x1000"]};
+  });
+  checkMethodTable(tableAfter(html, "<h2>Seconds per render at 20 spp"), summary, 0.001, [](const nlohmann::json& b) {
+    return std::vector<double>{b["time_s"]["wall"], b["time_s"]["kernel"], b["time_s"]["allocation"]};
+  });
 }
 
 TEST_CASE("compare rejects bad options before it writes anything", "[cli][compare][bad-input]") {
@@ -177,16 +291,11 @@ TEST_CASE("compare rejects bad options before it writes anything", "[cli][compar
     std::string args, expected;
   };
   const Case cases[] = {
-      {"--budgets 0,10", "--budgets"},
-      {"--budgets 20,10", "ascending"},
-      {"--budgets 10,x", "'x' is not a number"},
-      {"--methods equal,magic", "magic"},
-      {"--methods equal,equal", "listed twice"},
-      {"--methods exact --budgets 3", "smaller than the pilot"},
-      {"--repeats 0", "--repeats: '0'"},
-      {"--suite --envmap forest_slope", "drop --envmap"},
-      {"--envmap /no/such.exr", "/no/such.exr"},
-      {"--cost 1", "expected 2 numbers"},
+      {"--budgets 0,10", "--budgets"},           {"--budgets 20,10", "ascending"},
+      {"--budgets 10,x", "'x' is not a number"}, {"--methods equal,magic", "magic"},
+      {"--methods equal,equal", "listed twice"}, {"--methods exact --budgets 3", "smaller than the pilot"},
+      {"--repeats 0", "--repeats: '0'"},         {"--suite --envmap forest_slope", "drop --envmap"},
+      {"--envmap /no/such.exr", "/no/such.exr"}, {"--cost 1", "expected 2 numbers"},
   };
   for (const Case& c : cases) {
     auto r = runMisalloc(

@@ -2,7 +2,6 @@
 // sphere's pixels face the camera, each sphere of a grid has one BRDF, and pixels that see
 // no surface take no samples and count in no error, through every method's render.
 #include <fmt/format.h>
-#include <png.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -12,6 +11,7 @@
 
 #include "BiasCheck.h"
 #include "Error.h"
+#include "PictureChecks.h"
 #include "SceneFixtures.h"
 #include "render/Reference.h"
 #include "render/Render.h"
@@ -43,17 +43,6 @@ MeanAndError coveredMean(const RgbImage& image) {
     if (image.covers(p))
       rgb.insert(rgb.end(), image.rgb.begin() + ptrdiff_t(3 * p), image.rgb.begin() + ptrdiff_t(3 * p + 3));
   return pixelMean(rgb);
-}
-
-// The RGB of an 8-bit PNG's bytes (libpng's simplified API), row 0 first.
-std::vector<uint8_t> decodePngRgb(const std::string& bytes) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  REQUIRE(png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()) != 0);
-  image.format = PNG_FORMAT_RGB;
-  std::vector<uint8_t> rgb(PNG_IMAGE_SIZE(image));
-  REQUIRE(png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr) != 0);
-  return rgb;
 }
 
 }  // namespace
@@ -187,7 +176,7 @@ TEST_CASE("background pixels take no samples and count in no error, whatever the
     CHECK(nonZeroBackground == 0);
     CHECK(uncounted == 0);
     // The α map's picture: red + blue = 255 where samples were split, black where none.
-    const std::vector<uint8_t> picture = decodePngRgb(encodeAlphaMaps(scene, r).png);
+    const std::vector<uint8_t> picture = decodePng(encodeAlphaMaps(scene, r).png).rgb;
     size_t misdrawn = 0;
     for (size_t p = 0; p < pixels; ++p) {
       const int red = picture[3 * p], blue = picture[3 * p + 2];

@@ -78,16 +78,15 @@ TEST_CASE("every estimator is unbiased against [HS14] eq. 6.17", "[unbiased]") {
 TEST_CASE("estimators agree on a real envmap and an oblique view", "[unbiased]") {
   // No closed form: each technique alone and their MIS estimate the same integral.
   const std::vector<double> views = smallTestSize() ? std::vector<double>{89.0} : std::vector<double>{0.0, 60.0, 89.0};
+  BiasFamily family(0.03, 3 * 2);
   for (double view : views) {
     Scene scene = smallScene("kloofendal_overcast", "uniform:0.3,0.7,20", 32, 32, false, EnvmapSampler::Alias, view);
-    MeanAndError equal = renderMean(scene, Method::Equal, Estimator::MultiSample, 256, 7);
-    for (Method m : {Method::Envmap, Method::Brdf}) {
-      MeanAndError r = renderMean(scene, m, Estimator::MultiSample, 256, 8);
-      double z = zScore(r.mean, equal.mean, std::hypot(r.standardError, equal.standardError));
-      INFO(fmt::format("view {} method {}: {} vs equal {} z {}", view, methodName(m), r.mean, equal.mean, z));
-      CHECK(std::abs(z) < kMaxZ);
-    }
+    const MeanAndError equal = renderMean(scene, Method::Equal, Estimator::MultiSample, 256, 7);
+    for (Method m : {Method::Envmap, Method::Brdf})
+      addAgreement(family, fmt::format("view {} {} against equal", view, methodName(m)),
+                   renderMean(scene, m, Estimator::MultiSample, 256, 8), equal);
   }
+  checkFamily(family);
 }
 
 TEST_CASE("resampling envmap candidates is unbiased against [HS14] eq. 6.17", "[unbiased][ris]") {
@@ -99,6 +98,9 @@ TEST_CASE("resampling envmap candidates is unbiased against [HS14] eq. 6.17", "[
   // the most the kernel takes; small test size: two BRDFs.
   const std::vector<int> picked = smallTestSize() ? std::vector<int>{0, 3} : std::vector<int>{0, 1, 2, 3, 4};
   const int candidateCounts[] = {1, 3, kMaxRisCandidates};
+  // At 32 spp, one candidate (envmap sampling) of the sharp lobe (ρs 0.95, n 100) sets the
+  // bound; its three candidates detect 11 %, sixteen 5 %, the other BRDFs 7 % and less.
+  BiasFamily family(0.2, 5 * 2 * 2 * 3);
   for (int i : picked) {
     const Case& c = cases[i];
     uint64_t seed = 700 + uint64_t(16 * i);
@@ -107,15 +109,14 @@ TEST_CASE("resampling envmap candidates is unbiased against [HS14] eq. 6.17", "[
       for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
         Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n),
                                  32, 32, split, s);
-        for (int M : candidateCounts) {
-          MeanAndError r = resampledMean(scene, M, 32, ++seed);
-          double z = zScore(r.mean, expected, r.standardError);
-          INFO(fmt::format("rhoD {} n {} K {} split {} cdf {} candidates {}: mean {} expected {} z {}", c.rhoD, c.n,
-                           c.K, split, s == EnvmapSampler::Cdf, M, r.mean, expected, z));
-          CHECK(std::abs(z) < kMaxZ);
-        }
+        for (int M : candidateCounts)
+          addEstimate(family,
+                      fmt::format("rhoD {} n {} K {} split {} cdf {} candidates {}", c.rhoD, c.n, c.K, split,
+                                  s == EnvmapSampler::Cdf, M),
+                      resampledMean(scene, M, 32, ++seed), expected);
       }
   }
+  checkFamily(family);
 }
 
 TEST_CASE("resampling from a compensated or optimal envmap pdf is refused: it would be biased",
@@ -127,6 +128,8 @@ TEST_CASE("resampling from a compensated or optimal envmap pdf is refused: it wo
   const std::string sun = "sun:40,90,0.5,1e5", diffuse = "uniform:1,0,1";
   const MeanAndError plain = resampledMean(smallScene(sun, diffuse, 32, 32), kDefaultRisCandidates, 64, 800);
   uint64_t seed = 800;
+  // Detected: past the family-wise bound of this test's two checks (tests/Statistics.h).
+  const double bound = twoSidedNormalBound(sidakLevel(1e-3, 2));
   for (const char* pdf : {"compensated", "optimal"}) {
     const Scene scene = smallScene(sun, diffuse, 32, 32, false, EnvmapSampler::Alias, 0, pdf);
     CHECK_THROWS_WITH(
@@ -135,7 +138,7 @@ TEST_CASE("resampling from a compensated or optimal envmap pdf is refused: it wo
             Catch::Contains("[TCE05]"));
     const MeanAndError r = resampledMean(scene, kDefaultRisCandidates, 64, ++seed);
     const double z = zScore(r.mean, plain.mean, std::hypot(r.standardError, plain.standardError));
-    INFO(fmt::format("{}: mean {} plain {} z {}", pdf, r.mean, plain.mean, z));
-    CHECK(z < -kMaxZ);
+    INFO(fmt::format("{}: mean {} plain {} z {} bound {}", pdf, r.mean, plain.mean, z, bound));
+    CHECK(z < -bound);
   }
 }
