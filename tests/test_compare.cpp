@@ -13,6 +13,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include "CliRunner.h"
@@ -276,6 +277,11 @@ TEST_CASE("compare writes its tables, plots, images and index.html", "[cli][comp
   // It names every case and method, and its tables' numbers are summary.json's.
   for (const auto& info : runs["cases"])
     CHECK(html.find(fmt::format("id=\"{}\"", info["label"].get<std::string>())) != std::string::npos);
+  // Each anchor once.
+  const std::regex anchor("id=\"([^\"]+)\"");
+  std::set<std::string> ids;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), anchor); it != std::sregex_iterator(); ++it)
+    CHECK(ids.insert((*it)[1]).second);
   checkMethodTable(tableAfter(html, "<h2>RMSE×1000 at 20 spp"), summary, 0.01, [](const nlohmann::json& b) {
     return std::vector<double>{b["rmse_x1000"], b["rmse_spread_x1000"]};
   });

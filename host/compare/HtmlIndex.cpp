@@ -81,7 +81,10 @@ std::string indexHtml(const Summary& s) {
     out +=
         fmt::format("<img src=\"{}\" alt=\"error against time, every method and pdf\">\n", plotFileName(scene.label));
     for (const CaseSummary* c : scene.cases) {
-      if (scene.cases.size() > 1) out += fmt::format("<h3 id=\"{0}\">{0}</h3>\n", c->info.label);
+      // The scene's heading holds the id of the case that shares its label.
+      if (scene.cases.size() > 1)
+        out += c->info.label == scene.label ? fmt::format("<h3>{}</h3>\n", c->info.label)
+                                            : fmt::format("<h3 id=\"{0}\">{0}</h3>\n", c->info.label);
       for (const LeftOutMethod& l : c->info.leftOut)
         out += fmt::format("<p class=\"note\">Not run: {} ({}).</p>\n", methodName(l.method), escapeHtml(l.why));
       out +=
