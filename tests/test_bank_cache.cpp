@@ -1,6 +1,7 @@
 // The optimal pdf's tables cached on disk (distributions/BankCache.h): a hit gives the
 // tables a build gives, bit for bit; a changed map, grid, view or sampler misses; a
 // damaged entry is rebuilt, never used.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -140,6 +141,13 @@ TEST_CASE("a damaged bank cache entry is rebuilt, never used", "[bankcache][opti
   }
   SECTION("a truncated file") { damageWith(good.substr(0, good.size() / 3)); }
   SECTION("an empty file") { damageWith(""); }
+  SECTION("a FIFO, which an open to read would wait on") {
+    std::filesystem::remove(path);
+    REQUIRE(mkfifo(path.c_str(), 0600) == 0);
+    const Scene again = optimalScene("sun:40,90,0.5,1e5", "seed000", dir);
+    CHECK_FALSE(again.tables.bankFromCache);
+    checkSameTables(built.tables, again.tables);
+  }
   SECTION("another key's entry") {
     const Scene other = optimalScene("cosk:3", "seed000", dir);
     std::ifstream in(bankCachePath(dir, keyOf(other)), std::ios::binary);

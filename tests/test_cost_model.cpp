@@ -2,6 +2,8 @@
 // it (sampling/LaunchWork.h), the fit on synthetic timing tables with a known answer,
 // the calibration and per-stage predictions of a real render, and the cost cache
 // (render/CostCache.h) that makes the renders that allocate with it repeatable.
+#include <sys/stat.h>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -240,6 +242,14 @@ TEST_CASE("the cost cache calibrates a sampler once and hands every later one th
     provideCostModel(fourth, scene, {cache, false});
     CHECK(fourth.costModel().source() == CostSource::Cached);
     CHECK(sameCosts(third.costModel(), fourth.costModel()));
+  }
+  SECTION("an entry that is not a regular file is replaced, never opened") {
+    std::filesystem::remove(path);
+    REQUIRE(mkfifo(path.c_str(), 0600) == 0);  // opening a FIFO to read would block
+    Sampler third(testDevice(), scene, config);
+    provideCostModel(third, scene, {cache, false});
+    CHECK(third.costModel().source() == CostSource::Calibrated);
+    CHECK(std::filesystem::is_regular_file(path));
   }
   SECTION("another map, config or kernel build is another entry") {
     const Scene other = smallScene("cosk:2", "seed000", 32, 32);

@@ -6,14 +6,17 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 
 #include "CliRunner.h"
 #include "Constants.h"
 #include "Error.h"
 #include "scene/Mesh.h"
+#include "scene/Scene.h"
 
 using namespace misalloc;
+namespace fs = std::filesystem;
 using misalloc::test::TempDir;
 
 namespace {
@@ -152,4 +155,30 @@ TEST_CASE("bad meshes and cameras are refused naming the problem", "[mesh][safet
       fmt::format("render --mesh {} --camera-origin 0,0,3 --view 10 --out {}", quad, (dir.path / "x.exr").string()));
   CHECK(r.exitCode == 2);
   CHECK(r.output.find("--mesh with --view") != std::string::npos);
+}
+
+TEST_CASE("the shipped mesh is found by its name, and renders its blob and its ground", "[mesh]") {
+  const std::string blobPath = resolveMeshSpec("blob");
+  CHECK(fs::path(blobPath).filename() == "blob.obj");
+  CHECK(fs::path(blobPath).parent_path().filename() == "meshes");
+  CHECK(fs::is_regular_file(blobPath));
+  CHECK(resolveMeshSpec("my/own.ply") == "my/own.ply");
+  CHECK_THROWS_WITH(resolveMeshSpec("bunny"), Catch::Contains("no shipped mesh of that name"));
+  GBufferOptions camera;
+  camera.cameraOrigin = "4,-3,2";
+  const GBufferImage seen = rasteriseMesh({blobPath, "0,0,-0.2", 45}, camera, 48, 32);
+  // The blob's upper half faces the camera, the ground up: both kinds of normal, and
+  // the sky above the horizon as background.
+  int ground = 0, blob = 0, background = 0;
+  for (size_t p = 0; p < seen.geometry.covered.size(); ++p) {
+    if (!seen.geometry.covered[p]) {
+      ++background;
+      continue;
+    }
+    const Vec3f& n = seen.geometry.pixels[p].normal;
+    (n[2] > 0.9999f && std::abs(n[0]) < 1e-4f && std::abs(n[1]) < 1e-4f ? ground : blob) += 1;
+  }
+  CHECK(ground > 100);
+  CHECK(blob > 100);
+  CHECK(background > 0);
 }

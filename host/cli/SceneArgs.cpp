@@ -45,8 +45,8 @@ void SceneArgs::add(CLI::App& command) {
                      "X,Y,Z: an orthographic G-buffer's view, towards the camera, in the G-buffer's space (in "
                      "place of positions and --camera-origin)");
   command.add_option("--mesh", options.mesh.path,
-                     "a triangle mesh (OBJ, PLY, ...) instead of --scene, seen by a pinhole camera from "
-                     "--camera-origin, in --convention's world");
+                     "a triangle mesh (OBJ, PLY, ...) or a shipped mesh's name (blob) instead of --scene, seen by "
+                     "a pinhole camera from --camera-origin, in --convention's world");
   command.add_option("--camera-target", options.mesh.target, "X,Y,Z: where the mesh's camera looks")
       ->capture_default_str();
   command.add_option("--fov", options.mesh.verticalFovDegrees, "the mesh's camera's vertical field of view, degrees")
@@ -81,6 +81,7 @@ void SceneArgs::usePlainPdfByDefault() { plainPdfByDefault = true; }
 
 SceneOptions SceneArgs::parsed() {
   std::tie(options.width, options.height) = parseImageSize(size);
+  options.mesh.path = resolveMeshSpec(options.mesh.path);
   const double pixels = double(options.width) * options.height;
   requireHostMemory(fmt::format("--size {} ({:g} pixels × {} B)", size, pixels, kRenderBytesPerPixel),
                     pixels * kRenderBytesPerPixel);

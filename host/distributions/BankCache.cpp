@@ -2,12 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <cstdio>
 #include <iostream>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -20,7 +20,6 @@ namespace {
 
 // Bumped whenever the tables or this layout change: older entries then miss.
 constexpr char kMagic[8] = {'M', 'A', 'B', 'A', 'N', 'K', '0', '1'};
-
 
 // The entry's bytes: plain values and length-prefixed vectors, in one order for both
 // directions.
@@ -138,6 +137,9 @@ std::variant<EnvmapTables, std::string> decode(const std::string& bytes, const s
 // One read into a buffer of the file's size: a stream's copies would cost as much as
 // the build the cache saves.
 std::optional<std::string> readWhole(const std::string& path) {
+  // A FIFO would block the open: an entry that is not a regular file is built again.
+  std::error_code notRegular;
+  if (!fs::is_regular_file(path, notRegular)) return std::nullopt;
   std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
   std::error_code error;
   const auto size = fs::file_size(path, error);
@@ -171,8 +173,7 @@ std::string bankCachePath(const std::string& cacheDir, const std::string& key) {
   return (fs::path(cacheDir) / "banks" / (key + ".bin")).string();
 }
 
-std::optional<EnvmapTables> readCachedBank(const std::string& cacheDir, const std::string& key,
-                                           const RgbImage& image) {
+std::optional<EnvmapTables> readCachedBank(const std::string& cacheDir, const std::string& key, const RgbImage& image) {
   const std::string path = bankCachePath(cacheDir, key);
   std::optional<std::string> bytes = readWhole(path);
   if (!bytes) return std::nullopt;

@@ -114,6 +114,15 @@ std::variant<CostModel, std::string> decode(const std::string& text, const std::
 // The entry's model where the file exists and reads back whole; a damaged one is named
 // on stderr unless `quiet`.
 std::optional<CostModel> readEntry(const std::string& path, const std::string& key, int techniques, bool quiet) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (!fs::exists(status)) return std::nullopt;
+  // A FIFO would block the open: anything but a regular file is replaced.
+  if (!fs::is_regular_file(status)) {
+    if (!quiet)
+      std::cerr << fmt::format("misalloc: the cached costs {} are not a regular file; calibrating them again\n", path);
+    return std::nullopt;
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
   const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

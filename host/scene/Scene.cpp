@@ -41,14 +41,16 @@ std::vector<std::string> Scene::techniqueNames() const {
 
 namespace {
 
-// Where shipped maps are looked for, in order.
-std::vector<std::string> envmapDirs() {
+// Where shipped data of `kind` (envmaps, meshes) is looked for, in order.
+std::vector<std::string> dataDirs(const std::string& kind) {
   std::vector<std::string> dirs;
-  if (const char* env = std::getenv("MISALLOC_DATA_DIR")) dirs.push_back(fmt::format("{}/envmaps", env));
-  dirs.push_back(MISALLOC_INSTALL_DATA_DIR "/envmaps");
-  dirs.push_back(MISALLOC_SOURCE_DIR "/data/envmaps");
+  if (const char* env = std::getenv("MISALLOC_DATA_DIR")) dirs.push_back(fmt::format("{}/{}", env, kind));
+  dirs.push_back(MISALLOC_INSTALL_DATA_DIR "/" + kind);
+  dirs.push_back(MISALLOC_SOURCE_DIR "/data/" + kind);
   return dirs;
 }
+
+std::vector<std::string> envmapDirs() { return dataDirs("envmaps"); }
 
 }  // namespace
 
@@ -76,6 +78,18 @@ std::string resolveEnvmapSpec(const std::string& spec) {
   }
   throw InputError(
       fmt::format("--envmap '{}': no such file, and no shipped map of that name in {}", spec, fmt::join(dirs, ", ")));
+}
+
+std::string resolveMeshSpec(const std::string& spec) {
+  if (spec.empty() || fs::exists(spec) || spec.find('/') != std::string::npos || spec.find('.') != std::string::npos)
+    return spec;
+  const std::vector<std::string> dirs = dataDirs("meshes");
+  for (const auto& dir : dirs) {
+    fs::path candidate = fs::path(dir) / (spec + ".obj");
+    if (fs::exists(candidate)) return candidate.string();
+  }
+  throw InputError(
+      fmt::format("--mesh '{}': no such file, and no shipped mesh of that name in {}", spec, fmt::join(dirs, ", ")));
 }
 
 EnvmapSampler parseEnvmapSampler(const std::string& name) {

@@ -105,6 +105,10 @@ std::string resolveEnvmapSpec(const std::string& spec);
 // sorted.
 std::vector<std::string> shippedEnvmapNames();
 
+// A shipped mesh's name ("blob": data/meshes/blob.obj) or a path, returned unchanged.
+// Throws InputError naming the places searched when a name matches no file.
+std::string resolveMeshSpec(const std::string& spec);
+
 EnvmapSampler parseEnvmapSampler(const std::string& name);
 
 }  // namespace misalloc
