@@ -144,7 +144,9 @@ TEST_CASE("merge refuses bands that do not make one run's image, and writes noth
       dir.path / "m.exr");
 }
 
-TEST_CASE("bands without --cost allocate with the cost cache's one calibration", "[band][cli]") {
+// [release-only]: the cost cache's host code runs sanitized in test_cost_model.cpp's cache tests,
+// a band's identity with its costs in the sanitized merges of bands above.
+TEST_CASE("bands without --cost allocate with the cost cache's one calibration", "[band][cli][release-only]") {
   TempDir dir("band_costs");
   // A band's sampler renders its rows, and takes the cached calibration of the whole
   // image's: the first band calibrates, the others and the whole render read it.

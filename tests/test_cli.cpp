@@ -45,7 +45,8 @@ TEST_CASE("render writes an image and a report", "[cli]") {
   CHECK(j["time_s"]["wall"].get<double>() >= j["time_s"]["kernel"].get<double>());
 }
 
-TEST_CASE("the default render is repeatable: its costs are calibrated once and cached", "[cli]") {
+// [release-only]: the cost cache's host code runs sanitized in test_cost_model.cpp's cache tests.
+TEST_CASE("the default render is repeatable: its costs are calibrated once and cached", "[cli][release-only]") {
   TempDir dir("repeatable");
   // The default method allocates by cost: without the cache, each run would allocate
   // with its own timings.

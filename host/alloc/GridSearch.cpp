@@ -531,7 +531,7 @@ GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCou
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
   run(noSamples, StoredSampleLayout{pixelCount, columns.count(), 0, 0},
       std::vector<double>(columns.techniqueCount, 1.0), GridRule::MinCostVariance,
-      PooledSelection{pixelCount, 1, 0, 0});
+      PooledSelection{pixelCount, 1, 0, 0, {}});
 }
 
 void GridSearch::reset() {
