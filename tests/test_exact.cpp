@@ -491,7 +491,7 @@ TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not it
   CHECK(moved >= 20);
   // Radius 0: every pixel by its own samples, and no ratio to weigh a pilot by.
   BothResults own = searchBoth(pixels, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 0,
-                               PooledSelection{width, height, 0, 0.02, {}});
+                               PooledSelection{width, height, 0, 0.02});
   CHECK(
       std::all_of(own.device.varianceRatio.begin(), own.device.varianceRatio.end(), [](float r) { return r == 1.0f; }));
 }

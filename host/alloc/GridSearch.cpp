@@ -18,10 +18,6 @@ namespace misalloc {
 
 static_assert(MA_GRID_MAX_TECHNIQUES == kMaxTechniques);
 
-std::vector<int32_t> PooledSelection::surfaceOfPixels() const {
-  return surfaces.empty() ? std::vector<int32_t>(std::size_t(width) * std::size_t(height), 0) : surfaces;
-}
-
 namespace {
 
 // B, the float16s of weight combinations that share one pass over a pixel's samples
@@ -139,12 +135,20 @@ void checkRule(GridRule rule, SampleColumns columns) {
     throw std::invalid_argument("grid search: rule (a) on samples with share columns");
 }
 
+// A search's surfaces, one per pixel: those given, or one surface.
+std::vector<int32_t> surfacesOfPixels(const std::vector<int32_t>& surfaces, int pixelCount) {
+  const std::size_t pixels = std::size_t(std::max(0, pixelCount));
+  if (surfaces.empty()) return std::vector<int32_t>(pixels, 0);
+  if (surfaces.size() != pixels)
+    throw std::invalid_argument(fmt::format("grid search: {} surfaces for {} pixels", surfaces.size(), pixels));
+  return surfaces;
+}
+
 void checkPooling(const std::optional<PooledSelection>& pooling, GridRule rule, int pixelCount) {
   if (!pooling) return;
   if (rule == GridRule::MaxEntropy) throw std::invalid_argument("grid search: rule (a) cannot pool its selection");
   if (std::size_t(pooling->width) * std::size_t(std::max(0, pooling->height)) != std::size_t(pixelCount) ||
-      pooling->radius < 0 || !(pooling->minGain >= 0 && pooling->minGain < 1) ||
-      !(pooling->surfaces.empty() || pooling->surfaces.size() == std::size_t(pixelCount)))
+      pooling->radius < 0 || !(pooling->minGain >= 0 && pooling->minGain < 1))
     throw std::invalid_argument(fmt::format("grid search: pooling over {}x{} pixels, radius {}, gain {} for {} pixels",
                                             pooling->width, pooling->height, pooling->radius, pooling->minGain,
                                             pixelCount));
@@ -500,7 +504,7 @@ int GridSearchResult::fallbackCount() const {
 }
 
 GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize, bool runningSums,
-                       bool optimalWeights)
+                       bool optimalWeights, const std::vector<int32_t>& surfaces)
     : device_(device),
       columns_(columns),
       pixelCount_(pixelCount),
@@ -525,13 +529,17 @@ GridSearch::GridSearch(const Device& device, SampleColumns columns, int pixelCou
   scores_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, scoreBytes);
   device.queue.enqueueFillBuffer(scores_, cl_uchar(0), 0, scoreBytes);
   scales_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, pixels * sizeof(float));
+  std::vector<int32_t> surfaceOf = surfacesOfPixels(surfaces, pixelCount);
+  surfaceOf.resize(pixels);
+  surfaces_ =
+      cl::Buffer(device.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, pixels * sizeof(int32_t), surfaceOf.data());
   reset();
   // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
   // with a search of no samples, not inside the first timed one.
   cl::Buffer noSamples(device.context, CL_MEM_READ_ONLY, sizeof(float));
   run(noSamples, StoredSampleLayout{pixelCount, columns.count(), 0, 0},
       std::vector<double>(columns.techniqueCount, 1.0), GridRule::MinCostVariance,
-      PooledSelection{pixelCount, 1, 0, 0, {}});
+      PooledSelection{pixelCount, 1, 0, 0});
 }
 
 void GridSearch::reset() {
@@ -589,10 +597,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
     cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
     cl::Buffer ratioOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(float));
-    std::vector<int32_t> surfaces = pooling->surfaceOfPixels();
-    cl::Buffer surfaceBuffer(device_.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                             surfaces.size() * sizeof(int32_t), surfaces.data());
-    bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, surfaceBuffer,
+    bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, surfaces_,
                    cl_int(pooling->width), cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost,
                    cl_int(grid.size()), cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)),
                    cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut);
@@ -623,12 +628,13 @@ struct GridSearchReference::RunningSums {
 };
 
 GridSearchReference::GridSearchReference(SampleColumns columns, int pixelCount, int gridSize, bool runningSums,
-                                         bool optimalWeights)
+                                         bool optimalWeights, const std::vector<int32_t>& surfaces)
     : columns_(columns),
       pixelCount_(pixelCount),
       gridSize_(gridSize),
       runningSums_(runningSums),
-      optimalWeights_(optimalWeights) {
+      optimalWeights_(optimalWeights),
+      surfaces_(surfacesOfPixels(surfaces, pixelCount)) {
   checkColumns(columns, optimalWeights);
   running_ = std::make_unique<RunningSums>();
   if (runningSums)
@@ -675,10 +681,9 @@ GridSearchResult GridSearchReference::run(const std::vector<float>& samples, con
   SelectionArrays selection = searched;
   if (pooling) {
     const int equal = nearestEqual(grid);
-    const std::vector<int32_t> surfaces = pooling->surfaceOfPixels();
 #pragma omp parallel for schedule(dynamic, 64)
     for (int pixel = 0; pixel < pixels; ++pixel)
-      selectPooledPixel(setup, *pooling, surfaces, equal, scores, scales, searched, pixel, selection);
+      selectPooledPixel(setup, *pooling, surfaces_, equal, scores, scales, searched, pixel, selection);
   }
   GridSearchResult result = toResult(selection, columns_);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -79,12 +79,6 @@ struct PooledSelection {
   int width = 0, height = 0;
   int radius = 0;
   double minGain = 0;
-  // Per pixel, its surface (Scene::surfaces): a window pools over its pixel's surface
-  // only. Empty: one surface.
-  std::vector<int32_t> surfaces;
-
-  // `surfaces`, or one surface for every pixel where empty.
-  std::vector<int32_t> surfaceOfPixels() const;
 };
 
 struct GridSearchResult {
@@ -114,10 +108,12 @@ struct GridSearchResult {
 // optimalVarianceScore), and rule (a) is refused.
 class GridSearch {
  public:
-  // Throws std::invalid_argument for columns that makeWeightGrid rejects, share columns
-  // with optimal weights, or a grid size < 1.
+  // `surfaces`: per pixel, its surface (Scene::surfaces), within which a pooled selection
+  // pools; empty: one surface. Throws std::invalid_argument for columns that
+  // makeWeightGrid rejects, share columns with optimal weights, a grid size < 1, or
+  // surfaces of another pixel count.
   GridSearch(const Device& device, SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize,
-             bool runningSums = true, bool optimalWeights = false);
+             bool runningSums = true, bool optimalWeights = false, const std::vector<int32_t>& surfaces = {});
 
   // Throws std::invalid_argument for a layout that does not match the columns, the
   // pixel count or the buffer, taken > capacity, costs that makeWeightGrid rejects,
@@ -136,7 +132,7 @@ class GridSearch {
   bool runningSums_, optimalWeights_;
   bool added_ = false;  // a search since reset() added samples
   cl::Kernel kernel_, poolKernel_;
-  cl::Buffer summaries_, sums_, prepared_, scores_, scales_;
+  cl::Buffer summaries_, sums_, prepared_, scores_, scales_, surfaces_;
   std::size_t preparedFloats_ = 0;
 };
 
@@ -146,7 +142,7 @@ class GridSearch {
 class GridSearchReference {
  public:
   GridSearchReference(SampleColumns columns, int pixelCount, int gridSize = kDefaultGridSize, bool runningSums = true,
-                      bool optimalWeights = false);
+                      bool optimalWeights = false, const std::vector<int32_t>& surfaces = {});
   ~GridSearchReference();
 
   GridSearchResult run(const std::vector<float>& samples, const StoredSampleLayout& layout,
@@ -160,6 +156,7 @@ class GridSearchReference {
   int pixelCount_, gridSize_;
   bool runningSums_, optimalWeights_;
   bool added_ = false;
+  std::vector<int32_t> surfaces_;  // one per pixel
   std::unique_ptr<RunningSums> running_;
 };
 

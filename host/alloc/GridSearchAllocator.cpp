@@ -38,15 +38,17 @@ KeptGridSearch& keptSearch(StageStatistics& stages) {
   auto kept = std::make_unique<KeptGridSearch>();
   if (const Device* device = stages.storedSampleDevice()) {
     try {
-      kept->device = std::make_unique<GridSearch>(*device, sampleColumns(scene, config), scene.pixelCount(),
-                                                  config.gridSize, config.runningSums, ranksOptimalWeights(stages));
+      kept->device =
+          std::make_unique<GridSearch>(*device, sampleColumns(scene, config), scene.pixelCount(), config.gridSize,
+                                       config.runningSums, ranksOptimalWeights(stages), scene.surfaces);
     } catch (const cl::Error& e) {
       // The grid's sums and scores are the search's largest buffers.
       throw explainBufferError(e, *device, fmt::format("--grid-u {}", config.gridSize), scene.pixelCount());
     }
   } else {
-    kept->host = std::make_unique<GridSearchReference>(sampleColumns(scene, config), scene.pixelCount(),
-                                                       config.gridSize, config.runningSums, ranksOptimalWeights(stages));
+    kept->host =
+        std::make_unique<GridSearchReference>(sampleColumns(scene, config), scene.pixelCount(), config.gridSize,
+                                              config.runningSums, ranksOptimalWeights(stages), scene.surfaces);
   }
   stages.kept() = std::move(kept);
   return static_cast<KeptGridSearch&>(*stages.kept());

@@ -2,17 +2,16 @@
 
 #include <fmt/format.h>
 
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <memory>
 #include <optional>
 #include <type_traits>
 #include <variant>
 
 #include "AtomicFile.h"
 #include "ContentHash.h"
+#include "WholeFile.h"
 
 namespace misalloc {
 namespace fs = std::filesystem;
@@ -134,21 +133,6 @@ std::variant<EnvmapTables, std::string> decode(const std::string& bytes, const s
   return tables;
 }
 
-// One read into a buffer of the file's size: a stream's copies would cost as much as
-// the build the cache saves.
-std::optional<std::string> readWhole(const std::string& path) {
-  // A FIFO would block the open: an entry that is not a regular file is built again.
-  std::error_code notRegular;
-  if (!fs::is_regular_file(path, notRegular)) return std::nullopt;
-  std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-  std::error_code error;
-  const auto size = fs::file_size(path, error);
-  if (!file || error) return std::nullopt;
-  std::string bytes(size, '\0');
-  if (std::fread(bytes.data(), 1, size, file.get()) != size) return std::nullopt;
-  return bytes;
-}
-
 }  // namespace
 
 std::string bankCacheKey(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
@@ -175,7 +159,7 @@ std::string bankCachePath(const std::string& cacheDir, const std::string& key) {
 
 std::optional<EnvmapTables> readCachedBank(const std::string& cacheDir, const std::string& key, const RgbImage& image) {
   const std::string path = bankCachePath(cacheDir, key);
-  std::optional<std::string> bytes = readWhole(path);
+  std::optional<std::string> bytes = readWholeFile(path);
   if (!bytes) return std::nullopt;
   auto decoded = decode(*bytes, key, image);
   if (auto* tables = std::get_if<EnvmapTables>(&decoded)) {

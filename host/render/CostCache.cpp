@@ -4,9 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -15,6 +13,7 @@
 #include "AtomicFile.h"
 #include "ContentHash.h"
 #include "FileLock.h"
+#include "WholeFile.h"
 #include "render/Reference.h"
 
 namespace misalloc {
@@ -115,18 +114,15 @@ std::variant<CostModel, std::string> decode(const std::string& text, const std::
 // on stderr unless `quiet`.
 std::optional<CostModel> readEntry(const std::string& path, const std::string& key, int techniques, bool quiet) {
   std::error_code error;
-  const fs::file_status status = fs::status(path, error);
-  if (!fs::exists(status)) return std::nullopt;
-  // A FIFO would block the open: anything but a regular file is replaced.
-  if (!fs::is_regular_file(status)) {
+  if (!fs::exists(path, error)) return std::nullopt;
+  const std::optional<std::string> text = readWholeFile(path);
+  if (!text) {
     if (!quiet)
-      std::cerr << fmt::format("misalloc: the cached costs {} are not a regular file; calibrating them again\n", path);
+      std::cerr << fmt::format(
+          "misalloc: the cached costs {} are not a readable regular file; calibrating them again\n", path);
     return std::nullopt;
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  auto decoded = decode(text, key, techniques);
+  auto decoded = decode(*text, key, techniques);
   if (auto* model = std::get_if<CostModel>(&decoded)) return std::move(*model);
   if (!quiet)
     std::cerr << fmt::format("misalloc: the cached costs {} are damaged ({}); calibrating them again\n", path,

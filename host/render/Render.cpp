@@ -210,9 +210,7 @@ std::unique_ptr<StageAllocator> makeStageAllocator(StageSampler& sampler, Method
     const GridRule rule = traits.split == Split::Probed ? GridRule::MinCostVariance : options.gridRule;
     const Scene& scene = sampler.scene();
     std::optional<PooledSelection> pooling;
-    if (pooled)
-      pooling =
-          PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain, scene.surfaces};
+    if (pooled) pooling = PooledSelection{scene.grid.width, scene.grid.height, options.poolRadius, options.minGain};
     return std::make_unique<GridSearchAllocator>(sampler, rule, pooling);
   }
   PixelRule rule;
