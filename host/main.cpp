@@ -7,7 +7,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <new>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <vector>
 
 #include "Error.h"
@@ -28,9 +32,23 @@ void refuseUnknownSubcommand(const CLI::App& app, int argc, char** argv) {
     throw InputError(fmt::format("unknown subcommand '{}'; the subcommands are {}", argv[1], fmt::join(names, ", ")));
 }
 
+// A render allocates each stage's sums afresh: 30–100 MB at 1024×1024. glibc serves
+// blocks that large with fresh pages from the kernel and returns them when freed, so
+// every stage paid a page fault per 4 KiB on first touch: half the host's time at
+// 1024×1024 on the EPYC and most of it on a GPU (docs/results.md, "The host's page
+// faults"). Kept in the heap, a freed block serves the next stage; the process's peak
+// memory is what it was.
+void keepFreedBlocksInHeap() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  keepFreedBlocksInHeap();
   CLI::App app{"misalloc: per-pixel allocation of MIS samples for envmap x BRDF direct lighting"};
   app.require_subcommand(1);
   setParsingRules(app);
