@@ -403,6 +403,32 @@ TEST_CASE("a G-buffer's BRDF channels give each pixel its BRDF, its UV channels 
     CHECK_THROWS_WITH(makeScene(o),
                       Catch::Contains("holds some of the BRDF channels rho_d, rho_s, phong_n but not all"));
   }
+  SECTION("a roughness channel in the exponent's place") {
+    Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
+    w.names.insert(w.names.end(), {"rho_d", "rho_s", "roughness"});
+    w.planes.resize(w.planes.size() + 3, std::vector<float>(pixels, 0.5f));
+    w.planes[9][0] = 0.0f;
+    w.planes[9][1] = 1.0f;
+    w.planes[9][5] = 7.0f;  // pixel 5 is background: not checked
+    o.gbuffer.path = (dir.path / "rough.exr").string();
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    const Scene scene = makeScene(o);
+    CHECK(scene.grid.spec == kGBufferRoughnessBrdf);
+    // r = 1/2: α = 1/4, α_p = 2·16 − 2 = 30, n = 30/4.
+    CHECK(scene.grid.pixels[9].n == 7.5f);
+    CHECK(scene.grid.pixels[0].n == 1e5f);
+    CHECK(scene.grid.pixels[1].n == 0.0f);
+    CHECK(scene.grid.pixels[9].rhoS == 0.5f);
+    // A roughness outside [0, 1] on a covered pixel, and both exponents at once.
+    w.planes[9][9] = std::nanf("");
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    CHECK_THROWS_WITH(makeScene(o), Catch::Contains("the covered pixel at x=1, y=1 has roughness nan, outside [0, 1]"));
+    w.planes[9][9] = 0.5f;
+    w.names.push_back("phong_n");
+    w.planes.push_back(std::vector<float>(pixels, 10.0f));
+    writeRawChannels(o.gbuffer.path, kWidth, kHeight, w.names, w.planes);
+    CHECK_THROWS_WITH(makeScene(o), Catch::Contains("holds both phong_n and roughness"));
+  }
   SECTION("UV channels") {
     Written w = inConvention(truth, GBufferConvention::Misalloc, "N", "P");
     w.names.insert(w.names.end(), {"uv.U", "uv.V"});
@@ -449,4 +475,23 @@ TEST_CASE("misalloc gbuffer writes a scene that render --gbuffer renders as the 
   // It never replaces its own input.
   r = runMisalloc(fmt::format("gbuffer --gbuffer {0} --out {0}", gbuffer));
   CHECK(r.exitCode == 2);
+}
+
+// Independent of the mapping's derivation: the half-maximum angle of the Phong lobe about
+// the mirror direction against that of the Beckmann distribution of half vectors at
+// α = r², whose reflected directions turn twice as far. They agree as the lobe narrows.
+TEST_CASE("a roughness's Phong lobe is as wide as its Beckmann microfacet distribution", "[gbuffer]") {
+  for (double r : {0.05, 0.1, 0.2, 0.3, 0.4}) {
+    const double a2 = r * r * r * r;
+    auto beckmannOverPeak = [&](double t) {
+      return std::exp(-std::tan(t) * std::tan(t) / a2) / std::pow(std::cos(t), 4) - 0.5;
+    };
+    double lo = 0, hi = 1.5;
+    for (int i = 0; i < 200; ++i) (beckmannOverPeak(0.5 * (lo + hi)) > 0 ? lo : hi) = 0.5 * (lo + hi);
+    const double halfVectorAngle = 0.5 * (lo + hi);
+    const double n = phongExponentOfRoughness(r);
+    const double lobeAngle = std::acos(std::pow(0.5, 1 / n));
+    INFO("r = " << r << ", n = " << n);
+    CHECK(lobeAngle == Approx(2 * halfVectorAngle).epsilon(0.02));
+  }
 }

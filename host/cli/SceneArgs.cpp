@@ -128,11 +128,9 @@ Scene SceneArgs::make() {
     throw InputError(fmt::format("--size {}: the G-buffer {} is {}x{}", size, options.gbuffer.path, scene.grid.width,
                                  scene.grid.height));
   size = fmt::format("{}x{}", scene.grid.width, scene.grid.height);  // a G-buffer's, given or not
-  if (scene.grid.spec == kGBufferBrdf && app && app->count("--grid") > 0)
-    throw InputError(
-        fmt::format("--grid with --gbuffer {}: the G-buffer holds each pixel's BRDF (its channels "
-                    "rho_d, rho_s, phong_n)",
-                    options.gbuffer.path));
+  if (isGBufferBrdf(scene.grid.spec) && app && app->count("--grid") > 0)
+    throw InputError(fmt::format("--grid with --gbuffer {}: the G-buffer holds each pixel's BRDF (its channels {})",
+                                 options.gbuffer.path, scene.grid.spec.substr(scene.grid.spec.find(':') + 1)));
   const ReadWarnings& repaired = scene.envmapWarnings;
   if (repaired.negativeValues > 0)
     std::cerr << fmt::format("misalloc: warning: {}: {} negative values set to 0 (first at {})\n", scene.envmapPath,

@@ -21,8 +21,11 @@ struct BrdfGrid {
 // [HS14] Sec. 5.2: ρd(y) = (1−y)², ρs = 1−ρd, n(x) = −1 − 0.111211/(0.1 x^0.2 − 0.101101).
 float seed000Exponent(float x);
 
-// The spec of a grid read from a G-buffer's BRDF channels (scene/GBuffer.h).
+// The specs of a grid read from a G-buffer's BRDF channels (scene/GBuffer.h): the Phong
+// exponent given, or mapped from a roughness.
 constexpr const char* kGBufferBrdf = "gbuffer:rho_d,rho_s,phong_n";
+constexpr const char* kGBufferRoughnessBrdf = "gbuffer:rho_d,rho_s,roughness";
+inline bool isGBufferBrdf(const std::string& spec) { return spec.rfind("gbuffer:", 0) == 0; }
 
 // Where a pixel reads the grid's pattern: (u, v) ∈ [0,1]², u to the right, v down.
 struct SurfaceUv {

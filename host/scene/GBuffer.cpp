@@ -74,6 +74,7 @@ void requireChannels(const ExrHeader& header, const std::vector<std::string>& na
 }
 
 const std::vector<std::string> kBrdfChannels{"rho_d", "rho_s", "phong_n"};
+const std::vector<std::string> kRoughnessBrdfChannels{"rho_d", "rho_s", "roughness"};
 
 // The planes `names` of a G-buffer in memory, whose header lists them (requireChannels).
 std::vector<std::vector<float>> planesOf(const ChannelImage& image, const std::vector<std::string>& names) {
@@ -86,14 +87,21 @@ bool hasChannel(const ExrHeader& header, const std::string& name) {
   return std::find(header.channels.begin(), header.channels.end(), name) != header.channels.end();
 }
 
-// The BRDF channels, all or none.
-bool hasBrdfChannels(const ExrHeader& header, const std::string& path) {
-  const auto present = std::count_if(kBrdfChannels.begin(), kBrdfChannels.end(),
-                                     [&](const std::string& c) { return hasChannel(header, c); });
+// The BRDF channels the file holds, all three or none: rho_d, rho_s and either the Phong
+// exponent or a roughness.
+std::vector<std::string> brdfChannels(const ExrHeader& header, const std::string& path) {
+  if (hasChannel(header, "phong_n") && hasChannel(header, "roughness"))
+    throw InputError(
+        fmt::format("'{}' holds both phong_n and roughness, each of which would give the Phong exponent: "
+                    "keep one (channels found: {})",
+                    path, fmt::join(header.channels, ", ")));
+  const std::vector<std::string>& names = hasChannel(header, "roughness") ? kRoughnessBrdfChannels : kBrdfChannels;
+  const auto present =
+      std::count_if(names.begin(), names.end(), [&](const std::string& c) { return hasChannel(header, c); });
   if (present > 0 && present < 3)
     throw InputError(fmt::format("'{}' holds some of the BRDF channels {} but not all (channels found: {})", path,
-                                 fmt::join(kBrdfChannels, ", "), fmt::join(header.channels, ", ")));
-  return present == 3;
+                                 fmt::join(names, ", "), fmt::join(header.channels, ", ")));
+  return present == 3 ? names : std::vector<std::string>{};
 }
 
 // The convention's UV channels, where the file has them.
@@ -188,6 +196,17 @@ Vec inMapFrame(GBufferConvention convention, const Vec& d) {
 
 }  // namespace
 
+// α = r² ([Bur12] Sec. 5.4) is the width of a Beckmann distribution of microfacet
+// normals, which a Phong distribution of exponent α_p = 2/α² − 2 matches ([WMLT07]
+// Sec. 5.2). misalloc's lobe is about the mirror direction, whose angle from it is twice
+// the half vector's from the normal near the peak: cos^n(2θ) ≈ exp(−2nθ²) against
+// cos^α_p(θ) ≈ exp(−α_p θ²/2), so n = α_p/4 = (1 − r⁴)/(2r⁴).
+double phongExponentOfRoughness(double r) {
+  constexpr double kMaxExponent = 1e5;
+  const double r4 = r * r * r * r;
+  return r4 * (2 * kMaxExponent + 1) <= 1 ? kMaxExponent : (1 - r4) / (2 * r4);
+}
+
 GBufferConvention parseGBufferConvention(const std::string& name) {
   if (name == "misalloc") return GBufferConvention::Misalloc;
   if (name == "mitsuba") return GBufferConvention::Mitsuba;
@@ -227,13 +246,15 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   requireChannels(header, positionNames, options.path, "--position-channels");
   std::vector<std::string> names = normalNames;
   names.insert(names.end(), positionNames.begin(), positionNames.end());
-  const bool hasAlpha = hasChannel(header, "A"), hasBrdf = hasBrdfChannels(header, options.path);
+  const std::vector<std::string> brdfNames = brdfChannels(header, options.path);
+  const bool hasAlpha = hasChannel(header, "A"), hasBrdf = !brdfNames.empty();
+  const bool roughness = hasBrdf && brdfNames.back() == "roughness";
   const std::vector<std::string> uvNames =
       hasBrdf ? std::vector<std::string>{} : uvChannels(convention, prefixes, header);
   const size_t alphaPlane = names.size();
   if (hasAlpha) names.push_back("A");
   const size_t brdfPlane = names.size();
-  if (hasBrdf) names.insert(names.end(), kBrdfChannels.begin(), kBrdfChannels.end());
+  names.insert(names.end(), brdfNames.begin(), brdfNames.end());
   const size_t uvPlane = names.size();
   names.insert(names.end(), uvNames.begin(), uvNames.end());
   const std::vector<std::vector<float>> planes =
@@ -247,7 +268,10 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
   out.geometry.pixels.assign(pixels, PixelFrame{up, up});
   out.geometry.covered.assign(pixels, 0);
   auto where = [&](size_t p) { return fmt::format("x={}, y={}", p % size_t(out.width), p / size_t(out.width)); };
-  if (hasBrdf) out.brdf.assign(pixels, PhongParameters{0, 0, 1});
+  if (hasBrdf) {
+    out.brdf.assign(pixels, PhongParameters{0, 0, 1});
+    out.brdfSpec = roughness ? kGBufferRoughnessBrdf : kGBufferBrdf;
+  }
   for (size_t p = 0; p < pixels && !uvNames.empty(); ++p) {
     const double u = planes[uvPlane][p], v = planes[uvPlane + 1][p];
     out.uv.push_back({std::isfinite(u) ? u - std::floor(u) : 0.0, std::isfinite(v) ? v - std::floor(v) : 0.0});
@@ -287,7 +311,14 @@ GBufferImage readGBuffer(const GBufferOptions& options) {
     out.geometry.pixels[p] = PixelFrame{nf, mirrorDirection(nf, toFloat(view))};
     out.geometry.covered[p] = 1;
     if (hasBrdf) {
-      out.brdf[p] = {planes[brdfPlane][p], planes[brdfPlane + 1][p], planes[brdfPlane + 2][p]};
+      float exponent = planes[brdfPlane + 2][p];
+      if (roughness) {
+        if (!(exponent >= 0 && exponent <= 1))
+          throw InputError(fmt::format("'{}': the covered pixel at {} has roughness {:g}, outside [0, 1]", options.path,
+                                       where(p), exponent));
+        exponent = float(phongExponentOfRoughness(exponent));
+      }
+      out.brdf[p] = {planes[brdfPlane][p], planes[brdfPlane + 1][p], exponent};
       checkBrdf(out.brdf[p], options.path, where(p));
     }
   }

@@ -57,13 +57,20 @@ struct GBufferOptions {
 struct GBufferImage {
   int width = 0, height = 0;
   SceneGeometry geometry;
-  // The BRDF per pixel where the file holds channels rho_d, rho_s and phong_n; else
+  // The BRDF per pixel where the file holds channels rho_d, rho_s and phong_n or
+  // roughness (brdfSpec says which: kGBufferBrdf or kGBufferRoughnessBrdf); else
   // empty, and `uv` where it holds the convention's UV channels (misalloc, Mitsuba uv.U,
   // uv.V; Blender <ViewLayer>.UV.U, .V; pbrt u, v), wrapped into [0, 1), over which
   // --grid is laid; else both empty, and the grid lies over the image.
   std::vector<PhongParameters> brdf;
+  std::string brdfSpec;
   std::vector<SurfaceUv> uv;
 };
+
+// The Phong exponent of a perceptual roughness r ∈ [0, 1] (a `roughness` channel), as
+// Blender's Principled BSDF and Disney's BRDF take r: capped at 10⁵, the largest
+// exponent misalloc takes (r → 0).
+double phongExponentOfRoughness(double r);
 
 // Each pixel's frame (normal turned to face its view, the mirror direction of the view)
 // and coverage; the view from the channels view.X, .Y, .Z (towards the camera) where the
@@ -74,7 +81,8 @@ struct GBufferImage {
 // channel (naming those looked for and those found), a NaN or infinite normal or
 // position on a covered pixel, a camera origin missing where the convention needs one or
 // lying on a covered pixel's surface, a file that covers no pixel, some BRDF channels
-// without the others, a covered pixel's BRDF outside ρd, ρs ≥ 0, ρd + ρs ≤ 1, n ∈ [0, 10⁵].
+// without the others, both phong_n and roughness, a covered pixel's roughness outside
+// [0, 1], or its BRDF outside ρd, ρs ≥ 0, ρd + ρs ≤ 1, n ∈ [0, 10⁵].
 GBufferImage readGBuffer(const GBufferOptions& options);
 
 // The G-buffer of a scene as misalloc reads it back (--gbuffer, convention misalloc): N,

@@ -124,7 +124,7 @@ Scene makeScene(const SceneOptions& options) {
     scene.options.width = gbuffer.width;
     scene.options.height = gbuffer.height;
     if (!gbuffer.brdf.empty())
-      scene.grid = BrdfGrid{kGBufferBrdf, gbuffer.width, gbuffer.height, std::move(gbuffer.brdf)};
+      scene.grid = BrdfGrid{gbuffer.brdfSpec, gbuffer.width, gbuffer.height, std::move(gbuffer.brdf)};
     else if (!gbuffer.uv.empty())
       scene.grid = makeBrdfGrid(options.grid, gbuffer.width, gbuffer.height, gbuffer.uv);
     else
