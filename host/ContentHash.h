@@ -9,6 +9,7 @@
 #include <iterator>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "Error.h"
 
@@ -34,6 +35,12 @@ struct ContentHash {
   void addValue(T v) {
     static_assert(std::is_trivially_copyable_v<T>);
     add(&v, sizeof v);
+  }
+  // A vector's elements as bytes, its length with them.
+  template <typename T>
+  void addVector(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    add(v.data(), v.size() * sizeof(T));
   }
 
  private:

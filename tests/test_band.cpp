@@ -27,6 +27,12 @@ std::string renderArgs(const fs::path& dir, const std::string& method, const std
 
 std::string bandPath(const fs::path& dir, int k) { return (dir / fmt::format("band{}.exr", k)).string(); }
 
+// `merge` of `bands` into dir/`stem`.exr, its report dir/`stem`.json.
+std::string mergeArgs(const fs::path& dir, const std::string& stem, const std::vector<std::string>& bands) {
+  return fmt::format("merge --out {} --report {} {}", (dir / (stem + ".exr")).string(),
+                     (dir / (stem + ".json")).string(), fmt::join(bands, " "));
+}
+
 // Renders bands `ks` of `bands` of `method` with `extra`, each in a process of its own.
 void renderBands(const fs::path& dir, const std::string& method, const std::string& extra, int bands,
                  const std::vector<int>& ks) {
@@ -89,9 +95,8 @@ TEST_CASE("merged bands are the unsharded render bit for bit, for every method",
     INFO(whole.output);
     REQUIRE(whole.exitCode == 0);
     renderBands(dir.path, method, extra, 3, {0, 1, 2});
-    auto merged = runMisalloc(fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "merged.exr").string(),
-                                          (dir.path / "merged.json").string(), bandPath(dir.path, 2),
-                                          bandPath(dir.path, 0), bandPath(dir.path, 1)));
+    auto merged = runMisalloc(
+        mergeArgs(dir.path, "merged", {bandPath(dir.path, 2), bandPath(dir.path, 0), bandPath(dir.path, 1)}));
     INFO(merged.output);
     REQUIRE(merged.exitCode == 0);
     CHECK(readText(dir.path / "merged.exr") == readText(dir.path / "whole.exr"));
@@ -128,8 +133,7 @@ TEST_CASE("merge refuses bands that do not make one run's image, and writes noth
   renderBands(dir.path / "sub", "exact", "", 2, {1});  // another split of the same run
   const std::string b0 = bandPath(dir.path, 0), b1 = bandPath(dir.path, 1), b2 = bandPath(dir.path, 2);
   writeExr((dir.path / "plain.exr").string(), RgbImage{16, 8, std::vector<float>(16 * 8 * 3, 1.0f)});
-  const std::string merge =
-      fmt::format("merge --out {} --report {} ", (dir.path / "m.exr").string(), (dir.path / "m.json").string());
+  const std::string merge = mergeArgs(dir.path, "m", {});
   checkRefusals(
       dir.path,
       {{merge + b0 + " " + b1 + " " + bandPath(other, 2), "bands of different runs"},
@@ -161,20 +165,18 @@ TEST_CASE("bands without --cost allocate with the cost cache's one calibration",
   for (int k : {2, 0, 1}) render("cache", fmt::format("--shard {}/3", k), fmt::format("band{}.exr", k));
   render("cache", "", "whole.exr");
   CHECK(readText(dir.path / "report.json").find("\"costs_source\": \"cache\"") != std::string::npos);
-  auto merged = runMisalloc(fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "merged.exr").string(),
-                                        (dir.path / "merged.json").string(), bandPath(dir.path, 0),
-                                        bandPath(dir.path, 1), bandPath(dir.path, 2)));
+  auto merged =
+      runMisalloc(mergeArgs(dir.path, "merged", {bandPath(dir.path, 0), bandPath(dir.path, 1), bandPath(dir.path, 2)}));
   INFO(merged.output);
   REQUIRE(merged.exitCode == 0);
   CHECK(readText(dir.path / "merged.exr") == readText(dir.path / "whole.exr"));
   // A band calibrated apart (a node with a cache of its own) allocated with other costs.
   render("elsewhere", "--shard 1/3", "apart.exr");
-  checkRefusals(dir.path,
-                {{fmt::format("merge --out {} --report {} {} {} {}", (dir.path / "m.exr").string(),
-                              (dir.path / "m.json").string(), bandPath(dir.path, 0), (dir.path / "apart.exr").string(),
-                              bandPath(dir.path, 2)),
-                  "costs"}},
-                dir.path / "m.exr");
+  checkRefusals(
+      dir.path,
+      {{mergeArgs(dir.path, "m", {bandPath(dir.path, 0), (dir.path / "apart.exr").string(), bandPath(dir.path, 2)}),
+        "costs"}},
+      dir.path / "m.exr");
 }
 
 namespace {
@@ -213,8 +215,7 @@ TEST_CASE("merge compares the bands' inputs by content and their options by fina
     INFO(g.output);
     REQUIRE(g.exitCode == 0);
   }
-  const std::string merge =
-      fmt::format("merge --out {} --report {} ", (dir.path / "m.exr").string(), (dir.path / "m.json").string());
+  const std::string merge = mergeArgs(dir.path, "m", {});
   auto merged = [&](const std::string& prefix, const std::string& last) {
     return merge + fmt::format("{0}/{1}0.exr {0}/{1}1.exr {0}/{2}", dir.path.string(), prefix, last);
   };

@@ -56,7 +56,7 @@ uint64_t envmapTexelHash(const SceneOptions& scene) {
   h.addValue(map.image.width);
   h.addValue(map.image.height);
   h.addValue(map.coskExponent);
-  h.add(map.image.rgb.data(), map.image.rgb.size() * sizeof(float));
+  h.addVector(map.image.rgb);
   return h.h;
 }
 

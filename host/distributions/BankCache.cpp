@@ -140,11 +140,11 @@ std::string bankCacheKey(const Envmap& envmap, EnvmapSampler sampler, const Brdf
   ContentHash h;
   h.addValue(envmap.image.width);
   h.addValue(envmap.image.height);
-  h.add(envmap.image.rgb.data(), envmap.image.rgb.size() * sizeof(float));
+  h.addVector(envmap.image.rgb);
   h.addValue(sampler);
   h.addValue(grid.width);
   h.addValue(grid.height);
-  h.add(grid.pixels.data(), grid.pixels.size() * sizeof(PhongParameters));
+  h.addVector(grid.pixels);
   h.add(mirror.data(), sizeof mirror);
   h.addValue(options.exponentBins);
   h.addValue(options.diffuseBins);

@@ -23,24 +23,19 @@ namespace {
 // Changed whenever the entries' contents or their key change: older entries then miss.
 constexpr char kFormat[] = "misalloc cost model 1";
 
-template <typename T>
-void addVector(ContentHash& h, const std::vector<T>& v) {
-  h.add(v.data(), v.size() * sizeof(T));
-}
-
 // The envmap pdf's tables as the kernels read them, but the bank's bin of each pixel:
 // a band's tables hold its own rows' bins, which the image's BRDFs (the scene's part of
 // the key) decide.
 void addTables(ContentHash& h, const EnvmapTables& t) {
   h.addValue(t.width);
   h.addValue(t.height);
-  addVector(h, t.texels);
-  addVector(h, t.cdfTable);
-  addVector(h, t.aliasTable);
+  h.addVector(t.texels);
+  h.addVector(t.cdfTable);
+  h.addVector(t.aliasTable);
   h.addValue(t.useCdf);
   h.addValue(t.bankShares);
   h.addValue(t.blockLog2);
-  addVector(h, t.blockProbs);
+  h.addVector(t.blockProbs);
 }
 
 void addConfig(ContentHash& h, const SamplerConfig& c) {
@@ -164,8 +159,8 @@ std::string costCacheKey(const StageSampler& sampler, const Scene& image) {
   addTables(h, sampler.scene().tables);
   const ProductTables& product = sampler.scene().productTables;
   h.addValue(product.tables);
-  addVector(h, product.floats);
-  addVector(h, product.words);
+  h.addVector(product.floats);
+  h.addVector(product.words);
   // The image's map, size, view, frames and BRDFs, as its reference is keyed.
   h.add(referenceKey(image, 0));
   return fmt::format("{:016x}", h.h);

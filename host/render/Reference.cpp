@@ -115,9 +115,9 @@ std::string referenceKey(const Scene& scene, int spp) {
   // and the grid above).
   if (!scene.geometry.flat() || scene.geometry.hasBackground()) {
     const SceneGeometry& g = scene.geometry;
-    h.add(g.pixels.data(), g.pixels.size() * sizeof(PixelFrame));
-    h.add(g.covered.data(), g.covered.size());
-    h.add(scene.grid.pixels.data(), scene.grid.pixels.size() * sizeof(PhongParameters));
+    h.addVector(g.pixels);
+    h.addVector(g.covered);
+    h.addVector(scene.grid.pixels);
   }
   h.addValue(spp);
   h.add(referenceEstimator(scene.options));
@@ -147,8 +147,8 @@ const std::vector<std::string> kErrorChannels{"standard_error.R", "standard_erro
 
 uint64_t pixelChecksum(const SampledReference& reference) {
   ContentHash h;
-  h.add(reference.image.rgb.data(), reference.image.rgb.size() * sizeof(float));
-  h.add(reference.standardError.data(), reference.standardError.size() * sizeof(float));
+  h.addVector(reference.image.rgb);
+  h.addVector(reference.standardError);
   return h.h;
 }
 
