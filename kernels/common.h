@@ -11,6 +11,7 @@
 #ifdef __OPENCL_VERSION__
 #define MA_FN static inline __attribute__((always_inline))
 #define MA_GLOBAL __global
+#define MA_LOCAL __local
 #define ma_sqrt(x) sqrt(x)
 #define ma_floor(x) floor(x)
 #define ma_fma(a, b, c) fma(a, b, c)
@@ -40,6 +41,7 @@ typedef float ma_acc;
 #else
 #define MA_FN static inline __attribute__((always_inline))
 #define MA_GLOBAL
+#define MA_LOCAL
 typedef uint32_t ma_uint;
 typedef uint64_t ma_ulong;
 #define MA_UNROLL

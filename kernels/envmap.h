@@ -2,7 +2,8 @@
 // sin θ per texel, uniform in (φ, θ) inside the texel) and the two samplers with that
 // same pdf: an O(1) alias table and marginal/conditional CDFs with binary searches.
 // With the optimal pdf ([Kar19] eq. 9), a bank of tables over blocks of texels, one
-// per BRDF bin and envmap share, picks the block, and the plain pdf the texel in it.
+// per BRDF bin and envmap share, or the pixel's own table (kernels/pixel_optimal.h)
+// picks the block, and the plain pdf the texel in it.
 // Host side: host/scene/Envmap.h, host/distributions/EnvmapDistribution.h,
 // host/distributions/OptimalBank.h.
 #include "namespace_check.h"
@@ -34,6 +35,14 @@ typedef struct {
   MA_GLOBAL const float* blockProbs;  // per entry, per block: the probability of drawing the block
   int brdfBin;                        // the pixel's BRDF bin: its row of the bank
   int bankEntry;                      // the entry its stage samples with (bankEntryOf)
+  // The optimal pdf per pixel (kernels/pixel_optimal.h), in the bank's layout of texels
+  // and blocks: > 0, the blocks (cells) its CDF runs over; blockProbs then holds the
+  // cells (MA_CELL_FLOATS each), not probabilities.
+  int pixelCells;
+  MA_LOCAL const int*
+      pixelCdf;  // the pixel's CDF over its cells, entry c at pixelCdf[c · pixelCdfStride], as float bits
+  int pixelCdfStride;
+  int pixelCdfSteps;  // ceil(log2(pixelCells)): searchPixelCdf's steps
 } EnvmapView;
 
 typedef struct {
@@ -89,15 +98,54 @@ MA_FN int bankEntryOf(EnvmapView env, float envmapFraction) {
   return env.brdfBin * env.bankShares + bankShareOf(env.bankShares, envmapFraction);
 }
 
-// The bank's factor of texel t's probability: the probability of drawing its block.
-MA_FN float blockProbability(EnvmapView env, int t) {
-  return env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + blockOfTexel(env, t)];
+MA_FN float pixelCdfAt(EnvmapView env, int c) { return ma_as_float((ma_uint)env.pixelCdf[c * env.pixelCdfStride]); }
+
+// The probability that the pixel's CDF draws cell c. Its entries lie on uniformFloat's
+// grid (kernels/pixel_optimal.h), so the difference is exact and is the probability
+// that searchPixelCdf returns c.
+MA_FN float pixelCellProbability(EnvmapView env, int c) { return pixelCdfAt(env, c + 1) - pixelCdfAt(env, c); }
+
+// The most cells the pixel's CDF may have: searchPixelCdf takes at most 8 steps.
+#define MA_MAX_PIXEL_CELLS 256
+
+// One step of searchPixelCdf, where the search has steps left.
+MA_FN void pixelCdfStep(EnvmapView env, int stepIndex, float u, int* base, int* n) {
+  int step = *n >> 1;
+  int take = stepIndex < env.pixelCdfSteps && pixelCdfAt(env, *base + step) <= u;
+  *base = take ? *base + step : *base;
+  *n = stepIndex < env.pixelCdfSteps ? *n - step : *n;
 }
 
+// The last cell c with cdf[c] ≤ u: searchCdf over the pixel's CDF. A cell of
+// probability 0 is never returned. Written out step by step: a loop left in the
+// sample loop, unrolled or not, kept PoCL's sample loop scalar (3× the time per sample).
+MA_FN int searchPixelCdf(EnvmapView env, float u) {
+  int base = 0, n = env.pixelCells;
+  pixelCdfStep(env, 0, u, &base, &n);
+  pixelCdfStep(env, 1, u, &base, &n);
+  pixelCdfStep(env, 2, u, &base, &n);
+  pixelCdfStep(env, 3, u, &base, &n);
+  pixelCdfStep(env, 4, u, &base, &n);
+  pixelCdfStep(env, 5, u, &base, &n);
+  pixelCdfStep(env, 6, u, &base, &n);
+  pixelCdfStep(env, 7, u, &base, &n);
+  return base;
+}
+
+// The factor of texel t's probability that its block carries: the probability of
+// drawing the block, from the bank's entry or the pixel's own CDF.
+MA_FN float blockProbability(EnvmapView env, int t) {
+  int block = blockOfTexel(env, t);
+  return env.pixelCells > 0 ? pixelCellProbability(env, block)
+                            : env.blockProbs[env.bankEntry * blocksAcross(env) * blocksDown(env) + block];
+}
+
+MA_FN int drawsBlocks(EnvmapView env) { return env.bankShares > 0 || env.pixelCells > 0; }
+
 // The probability that envmap sampling draws texel t, from p, its probability within
-// its block (the optimal pdf's bank) or in the map.
+// its block (the optimal pdf's bank or per pixel) or in the map.
 MA_FN float bankedProbability(EnvmapView env, int t, float p) {
-  return env.bankShares > 0 ? p * blockProbability(env, t) : p;
+  return drawsBlocks(env) ? p * blockProbability(env, t) : p;
 }
 
 // The probability that envmap sampling draws texel t.
@@ -219,12 +267,19 @@ MA_FN EnvmapSample sampleEnvmapBank(EnvmapView env, MaRandom4 rnd) {
   return sampleTexelInBlock(env, env.aliasTable, block, across, env.blockLog2, rnd);
 }
 
+// The optimal pdf per pixel: a cell from the pixel's CDF (rnd.v[0]), then a texel in it.
+MA_FN EnvmapSample sampleEnvmapPixelCells(EnvmapView env, MaRandom4 rnd) {
+  int block = searchPixelCdf(env, uniformFloat(rnd.v[0]));
+  return sampleTexelInBlock(env, env.aliasTable, block, blocksAcross(env), env.blockLog2, rnd);
+}
+
 // The pdf of a drawn direction is that of the texel it was drawn in (as pbrt-v4's
 // ImageInfiniteLight::SampleLi): envmapTexelHit then needs no texelOfDirection, whose
 // inverse trigonometry and dependent gather would follow the alias table's gather.
 // Both agree except where rounding puts w on a neighbouring texel's edge.
 MA_FN EnvmapSample sampleEnvmap(EnvmapView env, MaRandom4 rnd) {
   if (env.bankShares > 0) return sampleEnvmapBank(env, rnd);
+  if (env.pixelCells > 0) return sampleEnvmapPixelCells(env, rnd);
   int t = env.useCdf
               ? sampleCdfTable(env, env.cdfTable, env.width, env.height, uniformFloat(rnd.v[0]), uniformFloat(rnd.v[1]))
               : sampleAliasTable(env.aliasTable, (ma_uint)(env.width * env.height), rnd.v[0], uniformFloat(rnd.v[1]));

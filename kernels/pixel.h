@@ -8,6 +8,7 @@
 #define MA_PIXEL_H
 #include "estimator.h"
 #include "pixel_layout.h"
+#include "pixel_optimal.h"
 #include "ris.h"
 
 typedef struct {
@@ -83,6 +84,12 @@ MA_FN void stageFractions(StageCounts c, float* alpha) {
 // vector, which stops PoCL vectorising the sample loop (docs/pocl.md, rule 8).
 MA_FN float bankEnvmapFraction(int product, int n0, int n1, float alpha0) {
   return product ? (float)n0 / (float)(n0 + n1 > 0 ? n0 + n1 : 1) : alpha0;
+}
+
+// The stage's envmap share C as bankEnvmapFraction takes it: the share that the bank's
+// entry and the optimal pdf per pixel are chosen or built for.
+MA_FN float stageEnvmapShare(int product, StageCounts c) {
+  return bankEnvmapFraction(product, c.n0, c.n1, (float)c.n0 / (float)c.stageSamples);
 }
 
 // The sample of `technique` with that technique's sample index `index`.

@@ -14,7 +14,9 @@ enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, S
 // What a pixel's samples share, one 32-bit word per row: its shading point (BRDF, BRDF
 // bin, normal, mirror direction), counts and first sample indices; then, with --weights
 // optimal, the coefficients a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with
-// --product, its ProductMixture (diffuse, specular, specular table).
+// --product, its ProductMixture (diffuse, specular, specular table); then, with the
+// optimal pdf per pixel, its CDF over the cells and the build's scratch
+// (kernels/pixel_optimal.h, pixelOptimalRows).
 enum {
   ROW_RHO_D,
   ROW_RHO_S,
@@ -37,11 +39,17 @@ enum {
 // Macros, for the kernel's local arrays; pixelRowCount for the host.
 #define MA_ROW_PRODUCT(optimalWeights, techniqueCount) \
   (ROW_COEFFICIENTS + ((optimalWeights) ? 3 * (techniqueCount) : 0))
-#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product) \
+#define MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) \
   (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
+// The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
+// scratch, pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS).
+#define MA_PIXEL_CHUNKS 16
+#define MA_PIXEL_CDF_ROWS(pixelCells) ((pixelCells) > 0 ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS : 0)
+#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells) \
+  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells))
 
-MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product) {
-  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product);
+MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells) {
+  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells);
 }
 
 // The per-pixel buffers, pixel p's first element. Shading point words: the first

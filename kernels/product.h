@@ -53,15 +53,6 @@ MA_FN int productExponentBin(float n) {
   return bin < 0 ? 0 : (bin >= MA_PRODUCT_EXPONENT_BINS ? MA_PRODUCT_EXPONENT_BINS - 1 : bin);
 }
 
-// ⌈2^24 x⌉ / 2^24 for x ∈ [0, 1]: uniformFloat's u < x holds with exactly this
-// probability, so a mixture chosen by such thresholds has the weights the pdf reads.
-MA_FN float ceilToUniformGrid(float x) {
-  float y = x * 16777216.0f;
-  int k = (int)y;
-  k += (float)k < y ? 1 : 0;
-  return (float)k * (1.0f / 16777216.0f);
-}
-
 // The pixel's mixture of the tables: diffuse with probability `diffuse`, its specular
 // table with `specular`, the plain envmap's with the rest.
 typedef struct {

@@ -40,4 +40,13 @@ MA_FN MaRandom4 philoxDraw(ma_uint seedLo, ma_uint seedHi, ma_uint pixel, ma_uin
 // The top 24 bits as a float in [0, 1): exact, never 1.
 MA_FN float uniformFloat(ma_uint bits) { return (float)(bits >> 8) * (1.0f / 16777216.0f); }
 
+// ⌈2^24 x⌉ / 2^24 for x ∈ [0, 1]: uniformFloat's u < x holds with exactly this
+// probability, so a mixture chosen by such thresholds has the weights the pdf reads.
+MA_FN float ceilToUniformGrid(float x) {
+  float y = x * 16777216.0f;
+  int k = (int)y;
+  k += (float)k < y ? 1 : 0;
+  return (float)k * (1.0f / 16777216.0f);
+}
+
 #endif

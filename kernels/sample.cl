@@ -9,7 +9,9 @@
 // bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
 // (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h),
 // MA_PRODUCT_TABLES, MA_PRODUCT_BLOCK_LOG2 and MA_PRODUCT_PLAIN_TEXELS (the product
-// technique's tables, kernels/product.h; 0: none), MA_STATS (the
+// technique's tables, kernels/product.h; 0: none), MA_PIXEL_CELLS and MA_PIXEL_CDF_STEPS
+// (the optimal pdf per pixel over that many blocks of 2^MA_BANK_BLOCK_LOG2 texels,
+// kernels/pixel_optimal.h; 0: none), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
 // weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE, and for
@@ -42,7 +44,8 @@
 // instruction, so each read at the pixel's index was one scalar load per lane
 // (docs/pocl.md, "How misalloc's kernels apply them").
 #define ROW_PRODUCT MA_ROW_PRODUCT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES)
-#define ROW_COUNT MA_PIXEL_ROW_COUNT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0)
+#define ROW_PIXEL_CDF MA_ROW_PIXEL_CDF(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0)
+#define ROW_COUNT MA_PIXEL_ROW_COUNT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0, MA_PIXEL_CELLS)
 
 MA_FN ProductView productView(__global const float* productFloats, __global const uint* productWords) {
   ProductView p;
@@ -88,6 +91,30 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #undef PIXEL_ROW
 }
 
+// What the optimal pdf per pixel is built from, read from the pixel's rows.
+typedef struct {
+  PhongParams brdf;
+  MaVec3 normal, mirror;
+  float envmapShare;  // stageEnvmapShare
+} PixelCdfInputs;
+
+MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride, int column, int stageSamples) {
+#define ROW_FLOAT(row) as_float(pixelRows[(row)*rowStride + column])
+  PixelCdfInputs in;
+  in.brdf.rhoD = ROW_FLOAT(ROW_RHO_D);
+  in.brdf.rhoS = ROW_FLOAT(ROW_RHO_S);
+  in.brdf.n = ROW_FLOAT(ROW_N);
+  in.normal = makeVec3(ROW_FLOAT(ROW_NORMAL_X), ROW_FLOAT(ROW_NORMAL_Y), ROW_FLOAT(ROW_NORMAL_Z));
+  in.mirror = makeVec3(ROW_FLOAT(ROW_MIRROR_X), ROW_FLOAT(ROW_MIRROR_Y), ROW_FLOAT(ROW_MIRROR_Z));
+  StageCounts c;
+  c.n0 = pixelRows[ROW_N0 * rowStride + column];
+  c.n1 = pixelRows[ROW_N1 * rowStride + column];
+  c.stageSamples = stageSamples;
+  in.envmapShare = stageEnvmapShare(MA_PRODUCT_TABLES > 0, c);
+  return in;
+#undef ROW_FLOAT
+}
+
 // The one-sample estimator's pass: the stage's samples, none for the background
 // (pixelStageSamples).
 MA_FN int oneSamplePassSamples(__local const int* pixelRows, int rowStride, int column) {
@@ -128,6 +155,10 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.blockProbs = blockProbs;
   env.brdfBin = (int)as_float(PIXEL_ROW(ROW_BRDF_BIN));
   env.bankEntry = 0;
+  env.pixelCells = MA_PIXEL_CELLS;
+  env.pixelCdf = pixelRows + (MA_PIXEL_CELLS > 0 ? ROW_PIXEL_CDF * rowStride + column : 0);
+  env.pixelCdfStride = rowStride;
+  env.pixelCdfSteps = MA_PIXEL_CDF_STEPS;
 
   TechniqueSet ts;
   ts.techniqueCount = MA_TECHNIQUES;
@@ -207,6 +238,14 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   __local int pixelRows[ROW_COUNT * MA_LOCAL_SIZE];
   loadPixelRows(pixelRows, MA_LOCAL_SIZE, lid, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
                 productWords, stageSamples, pixel);
+#if MA_PIXEL_CELLS > 0
+  // The background takes no samples and needs no table.
+  if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
+    PixelCdfInputs in = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare,
+                         pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid, MA_LOCAL_SIZE);
+  }
+#endif
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
   // that the technique is a constant in the loop and the vectorised code runs its
   // sampler only. A work-group runs its largest n_k; the other work-items' surplus
@@ -310,6 +349,36 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
   *pixelSums = sums;
 }
 
+#if MA_PIXEL_CELLS > 0
+// buildPixelOptimalCdf's passes, each shared among the lanes chunk by chunk. The
+// background's loops run no turns, and every lane meets every barrier.
+MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* cells, int stageSamples, int lid) {
+  __local int* rows = pixelRows + ROW_PIXEL_CDF * PIXEL_ROW_STRIDE;
+  int chunkEnd = oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0) > 0 ? MA_PIXEL_CHUNKS : 0;
+  PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
+  // The cells' terms in straight code, lane l taking cells l, L + l, ...: a loop left
+  // here keeps PoCL from vectorising across the lanes (the lobe's exp and log dominate).
+  MA_UNROLL
+  for (int k = 0; k < (MA_PIXEL_CELLS + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES; ++k) {
+    int c = k * MA_PIXEL_LANES + lid;
+    if (chunkEnd > 0 && c < MA_PIXEL_CELLS)
+      pixelOptimalCellTerms(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror, rows, PIXEL_ROW_STRIDE);
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
+    pixelOptimalChunkSums(cells, MA_PIXEL_CELLS, j, rows, PIXEL_ROW_STRIDE);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  PixelOptimalTerms t = pixelOptimalTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, in.envmapShare);
+  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
+    pixelOptimalChunkEq6(MA_PIXEL_CELLS, j, t, rows, PIXEL_ROW_STRIDE);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  PixelTableScales s = pixelTableScales(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, t);
+  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
+    pixelOptimalChunkCdf(cells, MA_PIXEL_CELLS, j, t, s, rows, PIXEL_ROW_STRIDE);
+  barrier(CLK_LOCAL_MEM_FENCE);
+}
+#endif
+
 __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void samplePixelStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local int pixelRows[ROW_COUNT * PIXEL_ROW_STRIDE];
   __local float terms[TERM_COUNT * CHUNK_SAMPLES];
@@ -322,6 +391,9 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
     pixelSums = zeroPixelSums();
   }
   barrier(CLK_LOCAL_MEM_FENCE);
+#if MA_PIXEL_CELLS > 0
+  buildPixelCdfInLanes(pixelRows, blockProbs, stageSamples, lid);
+#endif
   MA_UNROLL
   for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
     int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)

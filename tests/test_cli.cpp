@@ -165,7 +165,7 @@ TEST_CASE("render --scene spheres writes the background transparent black, and r
   CHECK(j["scene"]["shape"] == "spheres:2x2");
   CHECK(j["scene"]["covered_pixels"] == covered);
   CHECK(j["scene"]["view_deg"][0] == 75.0);
-  CHECK(j["scene"]["envmap_pdf"]["used"] == "compensated:0.5");
+  CHECK(j["scene"]["envmap_pdf"]["used"] == "optimal-pixel");
 }
 
 TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {

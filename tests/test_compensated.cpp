@@ -262,6 +262,64 @@ TEST_CASE("every method is unbiased with the optimal pdf against [HS14] eq. 6.17
   checkFamily(family);
 }
 
+TEST_CASE("every method is unbiased with the optimal pdf per pixel against [HS14] eq. 6.17",
+          "[compensated][optimal][unbiased]") {
+  // Each stage builds each pixel's table for its own envmap share: the staged methods
+  // run tables of other shares than the pilot's.
+  struct Case {
+    double rhoD, n, K;
+  };
+  const Case cases[] = {{0.5, 5, 1}, {0.2, 50, 3}, {0.9, 20, 0.5}};
+  uint64_t seed = 2900;
+  BiasFamily family(0.02);
+  for (const Case& c : cases) {
+    if (smallTestSize() && &c != &cases[0]) {
+      seed += kMethodsWithBrdfSampling.size();
+      continue;
+    }
+    const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+    Scene scene = compensatedScene(fmt::format("cosk:{}", c.K),
+                                   fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), "optimal-pixel");
+    REQUIRE(scene.tables.pixelCells > 0);
+    for (auto [m, e] : kMethodsWithBrdfSampling) {
+      addSized(family,
+               fmt::format("rhoD {} n {} K {} optimal-pixel {} one-sample {}", c.rhoD, c.n, c.K, methodName(m),
+                           e == Estimator::OneSample),
+               expected, 60, 60, ++seed, [&](int spp, uint64_t sd) { return imageMean(scene, m, e, spp, sd); });
+    }
+  }
+  checkFamily(family);
+}
+
+TEST_CASE("the optimal pdf per pixel refuses envmap sampling alone and split BRDF lobes, and reports its cells",
+          "[compensated][optimal][bad-input]") {
+  SceneOptions pixel;
+  pixel.envmapPdf = parseEnvmapPdf("optimal-pixel");
+  CHECK(envmapPdfName(pixel.envmapPdf) == "optimal-pixel");
+  CHECK_THROWS_WITH(requireValidRun(pixel, Method::Envmap, Estimator::MultiSample, 64, {}),
+                    Catch::Contains("--method envmap with --envmap-pdf optimal-pixel"));
+  CHECK_THROWS_WITH(compensatedScene("sun", "seed000", "optimal-pixel", EnvmapSampler::Alias, true),
+                    Catch::Contains("--envmap-pdf optimal-pixel with --split-brdf: not implemented"));
+
+  TempDir dir("optimal-pixel");
+  const std::string outputs = fmt::format("--out {} --report {} --reference none", (dir.path / "r.exr").string(),
+                                          (dir.path / "r.json").string());
+  auto ok = runMisalloc(
+      fmt::format("render --scene sphere --size 16x16 --spp 8 --method equal --envmap-pdf optimal-pixel {}", outputs));
+  INFO(ok.output);
+  REQUIRE(ok.exitCode == 0);
+  std::ifstream in(dir.path / "r.json");
+  const nlohmann::json pdf = nlohmann::json::parse(in)["scene"]["envmap_pdf"];
+  CHECK(pdf["used"] == "optimal-pixel");
+  CHECK(pdf["fallback_to_plain"] == false);
+  CHECK(pdf["pixel_cells"]["cells"].get<int>() > 1);
+
+  auto black = runMisalloc(fmt::format(
+      "render --size 8x8 --spp 8 --method equal --envmap constant:0 --envmap-pdf optimal-pixel {}", outputs));
+  REQUIRE(black.exitCode == 0);
+  CHECK(black.output.find("--envmap-pdf optimal-pixel falls back to plain") != std::string::npos);
+}
+
 TEST_CASE("the optimal pdf refuses envmap sampling alone and split BRDF lobes, and reports its bank",
           "[compensated][optimal][bad-input]") {
   SceneOptions optimal;

@@ -58,6 +58,21 @@ void checkDrawnTexels(const kern::EnvmapView& view, const std::vector<double>& p
   if (test.degreesOfFreedom > 0) CHECK(test.pValue() > level);
 }
 
+// ∫ p dω of the pdf that envmapLookup reads, by the midpoint rule on a grid 4 times the
+// map's resolution (the map's own above 100 000 texels).
+double midpointPdfIntegral(const kern::EnvmapView& view) {
+  const int k = double(view.width) * view.height > 100000 ? 1 : 4;
+  const int nu = k * view.width, nv = k * view.height;
+  double integral = 0;
+  for (int j = 0; j < nv; ++j) {
+    double v = (j + 0.5) / nv;
+    double rowWeight = 2 * kPi * kPi * std::sin(kPi * v) / (double(nu) * nv);
+    for (int i = 0; i < nu; ++i)
+      integral += kern::envmapLookup(view, kern::latLongDirection(float((i + 0.5) / nu), float(v))).pdf * rowWeight;
+  }
+  return integral;
+}
+
 std::vector<double> texelProbabilities(const EnvmapTables& tables) {
   std::vector<double> p(tables.texels.size() / 4);
   for (std::size_t t = 0; t < p.size(); ++t) p[t] = tables.texels[4 * t + 3];
@@ -402,19 +417,71 @@ TEST_CASE("the optimal pdf's bank draws texels with the probabilities it evaluat
         checkDrawnTexels(view, p, 200000, 0x0b7, uint32_t(entry), level);
 
         // The pdf a BRDF-sampled direction reads, by the midpoint rule (as for the plain pdf).
-        const int k = p.size() > 100000 ? 1 : 4;
-        const int nu = k * tables.width, nv = k * tables.height;
-        double integral = 0;
-        for (int j = 0; j < nv; ++j) {
-          double v = (j + 0.5) / nv;
-          double rowWeight = 2 * kPi * kPi * std::sin(kPi * v) / (double(nu) * nv);
-          for (int i = 0; i < nu; ++i)
-            integral +=
-                kern::envmapLookup(view, kern::latLongDirection(float((i + 0.5) / nu), float(v))).pdf * rowWeight;
-        }
-        CHECK(std::abs(integral - 1) <= 32 * kFloatRounding);
+        CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
       }
     }
+}
+
+TEST_CASE(
+    "the optimal pdf per pixel draws texels with the probabilities it evaluates, positive wherever the map is lit",
+    "[envmap][optimal]") {
+  // kernels/pixel_optimal.h: a cell by the pixel's own CDF, built from its normal, mirror
+  // direction, BRDF and envmap share, then a texel of the cell by the plain weights. A
+  // head-on diffuse-and-glossy pixel, a near-mirror lobe (n = 1e5) seen at a grazing
+  // angle from a tilted normal, a black BRDF (the plain table), a normal facing the
+  // map's lower half, and the envmap shares at both ends. A false alarm in any χ² test
+  // with probability 2 %.
+  struct Point {
+    const char* name;
+    kern::PhongParams brdf;
+    kern::MaVec3 normal, mirror;
+    float share;
+  };
+  const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
+  const kern::MaVec3 tilted = kern::makeVec3(0.8660254f, 0, 0.5f);  // 60° from the zenith
+  const kern::MaVec3 grazing = kern::makeVec3(-0.0871557f, 0, 0.9961947f);
+  const Point points[] = {
+      {"head-on glossy", {0.5f, 0.5f, 20.0f}, up, up, 0.5f},
+      {"near-mirror n 1e5 from a tilted normal", {0.0f, 1.0f, 1e5f}, tilted, grazing, 0.25f},
+      {"black BRDF", {0.0f, 0.0f, 1.0f}, up, up, 0.5f},
+      {"normal facing down", {0.8f, 0.2f, 5.0f}, kern::makeVec3(0, 0, -1), kern::makeVec3(0, 0, -1), 0.75f},
+      {"envmap share 1", {0.3f, 0.7f, 50.0f}, tilted, up, 1.0f},
+      {"envmap share 0", {0.3f, 0.7f, 50.0f}, tilted, up, 0.0f},
+  };
+  const double level = misalloc::test::sidakLevel(0.02, int(std::size(points) * testMaps().size()));
+  for (const auto& [name, map] : testMaps()) {
+    EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
+    INFO(name);
+    CHECK(tables.requestedPdf.pixelOptimal());
+    if (name == "all black") {
+      CHECK(tables.pixelCells == 0);  // falls back to the plain (uniform) tables
+      continue;
+    }
+    REQUIRE(tables.pixelCells > 0);
+    CHECK(tables.pixelCells <= MA_MAX_PIXEL_CELLS);
+    const std::vector<double> plain = misalloc::plainTexelWeights(map.image);
+    for (const Point& point : points) {
+      INFO(point.name);
+      kern::EnvmapView view = viewOf(tables);
+      std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells));
+      kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror,
+                                 point.share, rows.data(), 1);
+      view.pixelCdf = rows.data();
+      std::vector<double> p(std::size_t(tables.width) * tables.height);
+      double sum = 0;
+      std::size_t unlit = 0;
+      for (std::size_t t = 0; t < p.size(); ++t) {
+        sum += p[t] = kern::texelProbability(view, int(t));
+        unlit += plain[t] > 0 && !(p[t] > 0);
+      }
+      // A cell's and a texel's probability, each rounded to float, and their product.
+      CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
+      CHECK(unlit == 0);
+      checkDrawnTexels(view, p, 200000, 0x9e1, uint32_t(&point - points), level);
+      // The pdf a BRDF-sampled direction reads, by the midpoint rule.
+      CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
+    }
+  }
 }
 
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {

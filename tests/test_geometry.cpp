@@ -73,6 +73,19 @@ double quadratureValue(double K, double rhoD, double rhoS, double n, const Pixel
   return rhoD * diffuse + rhoS * (n + 2) / (2 * kPi) * lobe;
 }
 
+// A frame off the map's axis under cos^K θ: a wall facing the horizon, a tilted surface
+// seen at a grazing angle, and one facing the ground, lit only by the part of the sky
+// above its horizon; the second alone at the small test size.
+struct OffAxisCase {
+  Vec3d normal;
+  double view, K;
+};
+
+std::vector<OffAxisCase> offAxisCases() {
+  if (smallTestSize()) return {{{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}};
+  return {{{1, 0, 0}, 30, 1}, {{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}, {{0.6, 0, -0.8}, 45, 0.5}};
+}
+
 // Normal `normal` seen from `viewDegrees` off it.
 PixelFrame frameAt(const Vec3d& normal, double viewDegrees) {
   const auto [t, s] = basisAbout(normal);
@@ -139,21 +152,12 @@ TEST_CASE("under a constant map a diffuse pixel is rho_d in any frame (white fur
 }
 
 TEST_CASE("every estimator is unbiased in frames off the map's axis, against a quadrature", "[geometry][unbiased]") {
-  struct Case {
-    Vec3d normal;
-    double view, K;
-  };
-  // A wall facing the horizon, a tilted surface seen at a grazing angle, and one facing
-  // the ground, lit only by the part of the sky above its horizon.
-  const std::vector<Case> cases =
-      smallTestSize()
-          ? std::vector<Case>{{{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}}
-          : std::vector<Case>{{{1, 0, 0}, 30, 1}, {{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}, {{0.6, 0, -0.8}, 45, 0.5}};
+  const std::vector<OffAxisCase> cases = offAxisCases();
   const double rhoD = 0.3, rhoS = 0.7, n = 20;
   const std::string grid = fmt::format("uniform:{},{},{}", rhoD, rhoS, n);
   BiasFamily family(0.02);
   uint64_t seed = 1000;
-  for (const Case& c : cases) {
+  for (const OffAxisCase& c : cases) {
     const PixelFrame frame = frameAt(c.normal, c.view);
     const std::string map = fmt::format("cosk:{}", c.K);
     Scene scene = smallScene(map, grid, 32, 32), split = smallScene(map, grid, 32, 32, true);
@@ -164,6 +168,29 @@ TEST_CASE("every estimator is unbiased in frames off the map's axis, against a q
                       fmt::format("normal ({:.3f}, {:.3f}, {:.3f}) view {}° K {} (quadrature {:.6f})", c.normal[0],
                                   c.normal[1], c.normal[2], c.view, c.K, expected),
                       expected, seed);
+  }
+  checkFamily(family);
+}
+
+TEST_CASE("the optimal pdf per pixel is unbiased in frames off the map's axis, against a quadrature",
+          "[geometry][unbiased][optimal]") {
+  // Each pixel builds its table from its own normal and view.
+  const std::vector<OffAxisCase> cases = offAxisCases();
+  const double rhoD = 0.3, rhoS = 0.7, n = 20;
+  BiasFamily family(0.02);
+  uint64_t seed = 3000;
+  for (const OffAxisCase& c : cases) {
+    const PixelFrame frame = frameAt(c.normal, c.view);
+    Scene scene = smallScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", rhoD, rhoS, n), 32, 32, false,
+                             EnvmapSampler::Alias, 0, "optimal-pixel");
+    std::fill(scene.geometry.pixels.begin(), scene.geometry.pixels.end(), frame);
+    const double expected = quadratureValue(c.K, rhoD, rhoS, n, frame);
+    for (Estimator e : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent})
+      addSized(family,
+               fmt::format("normal ({:.3f}, {:.3f}, {:.3f}) view {}° K {}: equal estimator {}", c.normal[0],
+                           c.normal[1], c.normal[2], c.view, c.K, int(e)),
+               expected, 64, 4, ++seed,
+               [&](int spp, uint64_t sd) { return renderMean(scene, Method::Equal, e, spp, sd); });
   }
   checkFamily(family);
 }

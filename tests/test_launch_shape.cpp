@@ -34,7 +34,8 @@ int statSlotsOf(Method method, bool split) {
 }
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
-  return [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0)); };
+  return
+      [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0)); };
 }
 
 bool hasFp64(const cl::Device& device) {
@@ -50,10 +51,12 @@ TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, t
   CHECK(sampleKernelLocalBytes(64, 6, false, 10) == 64 * (15 * 4 + 11 * 4));
   CHECK(sampleKernelLocalBytes(8, 20, true, 16) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
   // The pixel's rows: BRDF (4), normal (3), mirror direction (3), counts (3), first
-  // indices (3); 3M coefficients; 3 product.
-  CHECK(kern::pixelRowCount(0, 2, 0) == 16);
-  CHECK(kern::pixelRowCount(1, 2, 0) == 22);
-  CHECK(kern::pixelRowCount(1, 3, 1) == 28);
+  // indices (3); 3M coefficients; 3 product; the optimal pdf per pixel's CDF over its
+  // cells (cells + 1), its scratch (cells) and 4 sums per chunk of cells.
+  CHECK(kern::pixelRowCount(0, 2, 0, 0) == 16);
+  CHECK(kern::pixelRowCount(1, 2, 0, 0) == 22);
+  CHECK(kern::pixelRowCount(1, 3, 1, 0) == 28);
+  CHECK(kern::pixelRowCount(0, 2, 0, 128) == 16 + 129 + 128 + 4 * MA_PIXEL_CHUNKS);
 }
 
 TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {
@@ -120,33 +123,38 @@ TEST_CASE("launch shape: PoCL's CPU device: its limits, and 8 work-items", "[lau
 
 TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the built sampleStage", "[launch]") {
   // The techniques (the BRDF as one, split, or with the product), the running sums of a
-  // method, the weights and the work-group size each change the kernel's local arrays:
-  // a pairwise covering set of them (tests/Covering.h), every one with
-  // MISALLOC_TEST_SIZE=exhaustive.
+  // method, the weights, the optimal pdf per pixel's rows and the work-group size each
+  // change the kernel's local arrays: a pairwise covering set of them (tests/Covering.h),
+  // every one with MISALLOC_TEST_SIZE=exhaustive.
   const Method methods[] = {Method::Equal, Method::Heuristic, Method::Linear};
-  std::vector<std::array<int, 4>> cases;
+  std::vector<std::array<int, 5>> cases;
   std::vector<Configuration> settings;
   for (int techniques : {0, 1, 2})
     for (int method = 0; method < 3; ++method)
       for (int optimal : {0, 1})
-        for (int localSize : {8, 64}) {
-          cases.push_back({techniques, method, optimal, localSize});
-          settings.push_back({fmt::format("techniques={}", techniques), fmt::format("method={}", method),
-                              fmt::format("optimal={}", optimal), fmt::format("local={}", localSize)});
-        }
+        for (int pixelPdf : {0, 1})
+          for (int localSize : {8, 64}) {
+            if (pixelPdf && techniques == 1) continue;  // eq. 9 takes the BRDF as one technique
+            cases.push_back({techniques, method, optimal, pixelPdf, localSize});
+            settings.push_back({fmt::format("techniques={}", techniques), fmt::format("method={}", method),
+                                fmt::format("optimal={}", optimal), fmt::format("pixel={}", pixelPdf),
+                                fmt::format("local={}", localSize)});
+          }
   const std::vector<size_t> chosen = configurationsToRun(settings);
   const Device& device = testDevice();
   const bool doubleSums = hasFp64(device.device);
   for (size_t c : chosen) {
-    const auto [techniques, method, optimal, localSize] = cases[c];
+    const auto [techniques, method, optimal, pixelPdf, localSize] = cases[c];
     const bool split = techniques == 1, product = techniques == 2;
-    Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split, EnvmapSampler::Alias, 0, "plain", product);
+    Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split, EnvmapSampler::Alias, 0,
+                             pixelPdf ? "optimal-pixel" : "plain", product);
+    if (pixelPdf) REQUIRE(scene.tables.pixelCells > 0);
     AdaptiveOptions options;
     options.weights = optimal ? MisWeights::Optimal : MisWeights::Balance;
     SamplerConfig config = samplerConfigFor(methods[method], Estimator::MultiSample, 64, options);
     const int statSlots = HostSampler(scene, config).statSlots();
-    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), product);
-    CAPTURE(split, product, methodName(methods[method]), optimal, localSize);
+    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), product, scene.tables.pixelCells);
+    CAPTURE(split, product, methodName(methods[method]), optimal, pixelPdf, localSize);
     cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
     CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==
           sampleKernelLocalBytes(localSize, statSlots, doubleSums, pixelRows));

@@ -125,7 +125,7 @@ TEST_CASE("bad --scene specs and views are refused, naming the option", "[scenes
   o.envmap = "constant";
   o.proceduralWidth = 64;
   CHECK(o.perPixelGeometry());
-  CHECK(envmapPdfName(defaultEnvmapPdf(o)) == "compensated:0.5");
+  CHECK(envmapPdfName(defaultEnvmapPdf(o)) == "optimal-pixel");
   o.envmapPdf = parseEnvmapPdf("optimal");
   CHECK_THROWS_WITH(makeScene(o), Catch::Contains("not implemented"));
   o.envmapPdf = {};
@@ -207,7 +207,7 @@ TEST_CASE("a sphere's reference is keyed on its pixels' frames, BRDFs and covera
   REQUIRE(sphere.geometry.covered == one.geometry.covered);
   CHECK(referenceKey(sphere, 64) != referenceKey(one, 64));
   CHECK(referenceKey(sphere, 64) != referenceKey(shapeScene("sphere", "constant", "seed000", 32, 32, 60), 64));
-  CHECK(referenceEstimator(sphere.options) == "equal-count MIS, compensated:0.5 envmap pdf");
+  CHECK(referenceEstimator(sphere.options) == "equal-count MIS, optimal-pixel envmap pdf");
 }
 
 TEST_CASE("under a constant map every covered pixel of a sphere is rho_d, through every method (white furnace)",

@@ -28,7 +28,7 @@ struct KeptGridSearch final : StageStatistics::Kept {
 // drawn from, and a stage whose table differs keeps the balance heuristic
 // (OptimalWeights.h, kWeightsOtherEnvmapTable), which its α must then suit.
 bool ranksOptimalWeights(const StageStatistics& stages) {
-  return stages.config().optimalWeights && !stages.scene().tables.hasBank();
+  return stages.config().optimalWeights && !stages.scene().tables.followsEnvmapShare();
 }
 
 KeptGridSearch& keptSearch(StageStatistics& stages) {

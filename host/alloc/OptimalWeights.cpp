@@ -87,12 +87,14 @@ PixelCoefficients solveOptimalWeights(const OptimalWeightsSystem& system) {
 }
 
 int envmapTableOf(const Scene& scene, const int32_t* counts) {
-  if (!scene.tables.hasBank()) return -1;
+  if (!scene.tables.followsEnvmapShare()) return -1;
   kern::EnvmapView view = makeEnvmapView(scene.tables, scene.envmap.coskExponent);
   int total = 0;
   for (int k = 0; k < scene.techniqueCount(); ++k) total += counts[k];
   const float alpha0 = (float)counts[0] / (float)total;  // the kernels' stageFractions
-  return kern::bankEntryOf(view, kern::bankEnvmapFraction(scene.productTables.enabled(), counts[0], counts[1], alpha0));
+  const float share = kern::bankEnvmapFraction(scene.productTables.enabled(), counts[0], counts[1], alpha0);
+  // The optimal pdf per pixel is built for the share itself: its bits name the table.
+  return scene.tables.hasBank() ? kern::bankEntryOf(view, share) : int(kern::ma_as_uint(share));
 }
 
 StageCoefficients optimalCoefficients(StageStatistics& stages, int poolRadius, const StagePlan& first,

@@ -47,7 +47,8 @@ enum OptimalWeightsFallback : unsigned {
 };
 
 // The optimal pdf's share (bankEntryOf, for BRDF bin 0) that a stage with a pixel's
-// counts [k] samples the envmap with, as the kernels compute it; −1 without a bank.
+// counts [k] samples the envmap with, as the kernels compute it, or for the optimal pdf
+// per pixel the bits of the share it builds its table for; −1 for a pdf that ignores α.
 int envmapTableOf(const Scene& scene, const int32_t* counts);
 
 // Each unknown of a channel's system wants about ten samples: the excess variance of

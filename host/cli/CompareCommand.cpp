@@ -112,10 +112,10 @@ int runCompare(CompareArgs& args) {
     // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
-  // Nor per-pixel normals and views: the normal-independent compensated pdf stands in.
+  // Nor per-pixel normals and views: each pixel's own optimal pdf stands in.
   if (compare.cases.front().scene.perPixelGeometry() && args.command->count("--envmap-pdfs") == 0 &&
       !compare.cases.front().scene.splitBrdf)
-    args.envmapPdfs = "plain,compensated";
+    args.envmapPdfs = "plain,optimal-pixel";
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
   const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
@@ -214,9 +214,11 @@ Subcommand addCompareCommand(CLI::App& app) {
   command->add_option("--methods", args->methods, "comma-separated methods, or all")->capture_default_str();
   command->add_option("--budgets", args->budgets, "samples per pixel, ascending")->capture_default_str();
   command
-      ->add_option("--envmap-pdfs", args->envmapPdfs,
-                   "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal (default: plain and "
-                   "optimal side by side; plain alone with --split-brdf; plain and compensated on spheres)")
+      ->add_option(
+          "--envmap-pdfs", args->envmapPdfs,
+          "envmap pdfs, each scene runs with each: plain, compensated[:C], optimal, optimal-pixel (default: plain and "
+          "optimal side by side; plain alone with --split-brdf; plain and optimal-pixel on spheres, G-buffers and "
+          "meshes)")
       ->capture_default_str();
   command
       ->add_option("--weights", args->weights,

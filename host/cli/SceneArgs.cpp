@@ -73,8 +73,9 @@ void SceneArgs::addEnvmapPdf(CLI::App& command) {
   envmapPdfOption = command.add_option(
       "--envmap-pdf", envmapPdf,
       "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C default 0.5) or "
-      "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables); default optimal, plain with "
-      "--split-brdf or --method envmap, compensated on spheres");
+      "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables) or optimal-pixel ([Kar19] eq. 6 "
+      "for each pixel's own normal, view, BRDF and share, built as it renders); default optimal, plain with "
+      "--split-brdf or --method envmap, optimal-pixel on spheres, G-buffers and meshes");
 }
 
 void SceneArgs::usePlainPdfByDefault() { plainPdfByDefault = true; }
@@ -143,9 +144,10 @@ Scene SceneArgs::make() {
         "misalloc: warning: envmap '{}': no texel exceeds 2(1-C) times the mean luminance; "
         "--envmap-pdf {} falls back to plain\n",
         options.envmap, envmapPdfName(scene.tables.requestedPdf));
-  if (scene.tables.requestedPdf.optimal() && !scene.tables.hasBank())
-    std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: --envmap-pdf optimal falls back to plain\n",
-                             options.envmap);
+  if ((scene.tables.requestedPdf.optimal() || scene.tables.requestedPdf.pixelOptimal()) &&
+      !scene.tables.followsEnvmapShare())
+    std::cerr << fmt::format("misalloc: warning: envmap '{}' is black: --envmap-pdf {} falls back to plain\n",
+                             options.envmap, envmapPdfName(scene.tables.requestedPdf));
   return scene;
 }
 

@@ -19,6 +19,7 @@ std::string caseLabel(const SceneOptions& scene) {
   if (scene.product) name += "-product";
   if (scene.envmapPdf.compensated()) name += "-comp" + envmapPdfName(scene.envmapPdf).substr(sizeof("compensated"));
   if (scene.envmapPdf.optimal()) name += "-optimal";
+  if (scene.envmapPdf.pixelOptimal()) name += "-optimal-pixel";
   return name;
 }
 

@@ -15,6 +15,7 @@ EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
   const std::string compensated = "compensated";
   if (spec == "plain") return {};
   if (spec == "optimal") return {EnvmapPdf::Kind::Optimal, 0.5};
+  if (spec == "optimal-pixel") return {EnvmapPdf::Kind::PixelOptimal, 0.5};
   if (spec == compensated) return {EnvmapPdf::Kind::Compensated, 0.5};
   if (spec.rfind(compensated + ":", 0) == 0) {
     const char* first = spec.data() + compensated.size() + 1;
@@ -25,7 +26,8 @@ EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
     throw InputError(
         fmt::format("{} {}: C, the envmap technique's share of the samples, must lie in (0, 1]", option, spec));
   }
-  throw InputError(fmt::format("{} '{}': expected plain, compensated, compensated:C or optimal", option, spec));
+  throw InputError(
+      fmt::format("{} '{}': expected plain, compensated, compensated:C, optimal or optimal-pixel", option, spec));
 }
 
 std::string envmapPdfName(const EnvmapPdf& pdf) {
@@ -34,6 +36,8 @@ std::string envmapPdfName(const EnvmapPdf& pdf) {
       return fmt::format("compensated:{:g}", pdf.envmapFraction);
     case EnvmapPdf::Kind::Optimal:
       return "optimal";
+    case EnvmapPdf::Kind::PixelOptimal:
+      return "optimal-pixel";
     case EnvmapPdf::Kind::Plain:
       break;
   }

@@ -13,9 +13,10 @@ namespace misalloc {
 
 // The shape of the envmap technique's pdf (`--envmap-pdf`).
 // `Optimal` is [Kar19] eq. 9 for each pixel's own BRDF and envmap share (a bank of
-// tables, host/distributions/OptimalBank.h).
+// tables, host/distributions/OptimalBank.h); `PixelOptimal` eq. 9 built by each pixel
+// for its own normal, view, BRDF and α_0 at run time (kernels/pixel_optimal.h).
 struct EnvmapPdf {
-  enum class Kind { Plain, Compensated, Optimal };
+  enum class Kind { Plain, Compensated, Optimal, PixelOptimal };
   Kind kind = Kind::Plain;
   // C of [Kar19] eq. 14: the envmap technique's share of the samples, in (0, 1].
   double envmapFraction = 0.5;
@@ -23,13 +24,14 @@ struct EnvmapPdf {
   bool plain() const { return kind == Kind::Plain; }
   bool compensated() const { return kind == Kind::Compensated; }
   bool optimal() const { return kind == Kind::Optimal; }
+  bool pixelOptimal() const { return kind == Kind::PixelOptimal; }
 };
 
-// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, or "optimal"; throws
+// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, "optimal" or "optimal-pixel"; throws
 // InputError, naming `option`, otherwise.
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option = "--envmap-pdf");
 
-// "plain", "compensated:C" or "optimal", which parseEnvmapPdf reads back.
+// "plain", "compensated:C", "optimal" or "optimal-pixel", which parseEnvmapPdf reads back.
 std::string envmapPdfName(const EnvmapPdf& pdf);
 
 // L̄ of [Kar19] eq. 14: the luminance of a W×H lat-long map (row-major, row 0 at the

@@ -12,6 +12,7 @@
 
 #include "Constants.h"
 #include "Error.h"
+#include "KernelCode.h"
 #include "distributions/AliasTable.h"
 
 namespace misalloc {
@@ -56,6 +57,40 @@ std::vector<double> sinThetaWeighted(std::vector<double> luminance, int width, i
     for (int col = 0; col < width; ++col) luminance[std::size_t(row) * std::size_t(width) + col] *= sinTheta;
   }
   return luminance;
+}
+
+// What the pdfs that draw a block and then a texel in it (the bank, the optimal pdf per
+// pixel) build on: the texels' luminance and plain weights, and their total.
+struct PlainWeights {
+  std::vector<double> luminance, weights;
+  double total = 0;
+};
+
+PlainWeights plainWeightsOf(const RgbImage& image) {
+  PlainWeights plain;
+  plain.luminance = texelLuminance(image);
+  plain.weights = sinThetaWeighted(plain.luminance, image.width, image.height);
+  for (double w : plain.weights) plain.total += w;
+  return plain;
+}
+
+// Texels: RGB and the probability within the block of 2^L texels a side that holds them
+// (0 in a block of no weight), as kernels/envmap.h's bankedProbability reads them.
+std::vector<float> texelsWithinBlocks(const RgbImage& image, const std::vector<double>& weights,
+                                      const std::vector<double>& blockMass, int blockLog2) {
+  const int width = image.width, across = (width + (1 << blockLog2) - 1) >> blockLog2;
+  std::vector<float> texels(weights.size() * 4);
+#pragma omp parallel for schedule(static)
+  for (int row = 0; row < image.height; ++row) {
+    const double* mass = blockMass.data() + std::size_t(row >> blockLog2) * across;
+    for (int col = 0; col < width; ++col) {
+      const std::size_t t = std::size_t(row) * width + col;
+      for (int c = 0; c < 3; ++c) texels[4 * t + c] = image.rgb[3 * t + c];
+      const double blockWeight = mass[col >> blockLog2];
+      texels[4 * t + 3] = float(blockWeight > 0 ? weights[t] / blockWeight : 0.0);
+    }
+  }
+  return texels;
 }
 
 // sin θ alone: uniform over the sphere.
@@ -165,10 +200,8 @@ void writeBlockSlotTables(const std::vector<double>& weights, int width, int hei
 }
 
 std::vector<double> plainTexelWeights(const RgbImage& image) {
-  std::vector<double> weights = sinThetaWeighted(texelLuminance(image), image.width, image.height);
-  double total = 0;
-  for (double w : weights) total += w;
-  return total > 0 ? weights : sphereWeights(image.width, image.height);
+  PlainWeights plain = plainWeightsOf(image);
+  return plain.total > 0 ? std::move(plain.weights) : sphereWeights(image.width, image.height);
 }
 
 EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const EnvmapPdf& pdf) {
@@ -225,27 +258,37 @@ EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, cons
   return tables;
 }
 
+namespace {
+
+// A pdf that draws blocks (`kind`): its tables before the blocks, the map's size, the
+// pdf and L̄; for a black map, the plain (uniform) tables it falls back to.
+EnvmapTables blockDrawnTables(const Envmap& envmap, EnvmapSampler sampler, const PlainWeights& plain,
+                              EnvmapPdf::Kind kind) {
+  if (!(plain.total > 0)) {
+    EnvmapTables fallback = buildEnvmapTables(envmap, sampler);
+    fallback.requestedPdf = {kind};
+    return fallback;
+  }
+  EnvmapTables tables;
+  tables.width = envmap.image.width;
+  tables.height = envmap.image.height;
+  tables.requestedPdf = tables.pdf = {kind};
+  tables.meanLuminance = solidAngleMeanLuminance(plain.luminance, tables.width, tables.height);
+  return tables;
+}
+
+}  // namespace
+
 EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
                                       const std::array<float, 3>& mirror, const OptimalBankOptions& options) {
   requireValidSize(envmap);
   const RgbImage& image = envmap.image;
   const int width = image.width, height = image.height;
-  const std::vector<double> luminance = texelLuminance(image);
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<double> weights = sinThetaWeighted(luminance, width, height);
-  double total = 0;
-  for (double w : weights) total += w;
-  if (!(total > 0)) {
-    EnvmapTables plain = buildEnvmapTables(envmap, sampler);
-    plain.requestedPdf = {EnvmapPdf::Kind::Optimal};
-    return plain;
-  }
-
-  EnvmapTables tables;
-  tables.width = width;
-  tables.height = height;
-  tables.requestedPdf = tables.pdf = {EnvmapPdf::Kind::Optimal};
-  tables.meanLuminance = solidAngleMeanLuminance(luminance, width, height);
+  const PlainWeights plain = plainWeightsOf(image);
+  const std::vector<double>& weights = plain.weights;
+  EnvmapTables tables = blockDrawnTables(envmap, sampler, plain, EnvmapPdf::Kind::Optimal);
+  if (!(plain.total > 0)) return tables;
   tables.bankShares = options.shares;
   tables.blockLog2 = options.blockLog2;
   const BrdfBins bins = binBrdfs(grid, options.exponentBins, options.diffuseBins);
@@ -254,21 +297,10 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   OptimalBankWeights bank = optimalBlockWeights(weights, width, height, bins, mirror, options);
   tables.bankVariances = bank.variances;
 
-  // Texels: RGB and the probability within the block.
   const int side = 1 << options.blockLog2;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
   const std::vector<double>& blockMass = bank.plainBlockMass;
-  tables.texels.resize(weights.size() * 4);
-#pragma omp parallel for schedule(static)
-  for (int row = 0; row < height; ++row) {
-    const double* mass = blockMass.data() + std::size_t(row >> options.blockLog2) * across;
-    for (int col = 0; col < width; ++col) {
-      const std::size_t t = std::size_t(row) * width + col;
-      for (int c = 0; c < 3; ++c) tables.texels[4 * t + c] = image.rgb[3 * t + c];
-      const double blockWeight = mass[col >> options.blockLog2];
-      tables.texels[4 * t + 3] = float(blockWeight > 0 ? weights[t] / blockWeight : 0.0);
-    }
-  }
+  tables.texels = texelsWithinBlocks(image, weights, blockMass, options.blockLog2);
 
   tables.useCdf = sampler == EnvmapSampler::Cdf;
   const std::size_t blocks = blockMass.size(), slotWords = 2 * blocks * side * side;
@@ -299,6 +331,64 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
     }
   }
   if (!tables.useCdf) tables.cdfTable = {0};
+  tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return tables;
+}
+
+int pixelCellLog2(int width) {
+  // At least 2 × 2 texels: sampleTexelInBlock draws a slot by a shift of 32 − 2L bits.
+  int log2 = 1;
+  while (((width + (1 << log2) - 1) >> log2) > kPixelCellsAcross) ++log2;
+  return log2;
+}
+
+EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
+  requireValidSize(envmap);
+  const RgbImage& image = envmap.image;
+  const int width = image.width, height = image.height;
+  const auto start = std::chrono::steady_clock::now();
+  const PlainWeights plain = plainWeightsOf(image);
+  EnvmapTables tables = blockDrawnTables(envmap, EnvmapSampler::Alias, plain, EnvmapPdf::Kind::PixelOptimal);
+  if (!(plain.total > 0)) return tables;
+  const int log2 = tables.blockLog2 = pixelCellLog2(width);
+  // A slot of a cell's alias table takes 2L of a draw's 32 bits, the rest are its coin.
+  if (log2 > kMaxPixelCellLog2)
+    throw InputError(fmt::format("envmap '{}' is {} texels wide: the optimal pdf per pixel takes at most {}",
+                                 envmap.description, width, kPixelCellsAcross << kMaxPixelCellLog2));
+  const int side = 1 << log2;
+  const int across = (width + side - 1) / side, down = (height + side - 1) / side;
+  tables.pixelCells = across * down;
+  tables.pixelCdfSteps = binarySearchSteps(tables.pixelCells);
+
+  // Per cell: the plain mass and the solid angle, each a sum over its texels.
+  std::vector<double> mass(std::size_t(tables.pixelCells), 0.0), solidAngle(mass.size(), 0.0);
+  const double texelArea = (2 * kPi / width) * (kPi / height);  // dω = sin θ dφ dθ
+  for (int row = 0; row < height; ++row) {
+    const double sinTheta = sinThetaOfRow(row, height);
+    for (int col = 0; col < width; ++col) {
+      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      mass[cell] += plain.weights[std::size_t(row) * width + col];
+      solidAngle[cell] += sinTheta * texelArea;
+    }
+  }
+  tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
+  tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
+  writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
+  // Cells: the centre of the texels they hold, the plain mass, the solid angle.
+  tables.blockProbs.assign(std::size_t(tables.pixelCells) * MA_CELL_FLOATS, 0.0f);
+  for (int cell = 0; cell < tables.pixelCells; ++cell) {
+    const int col0 = (cell % across) * side, row0 = (cell / across) * side;
+    const float u = float((col0 + 0.5 * std::min(side, width - col0)) / width);
+    const float v = float((row0 + 0.5 * std::min(side, height - row0)) / height);
+    const kern::MaVec3 centre = kern::latLongDirection(u, v);
+    float* out = tables.blockProbs.data() + std::size_t(cell) * MA_CELL_FLOATS;
+    out[0] = centre.x;
+    out[1] = centre.y;
+    out[2] = centre.z;
+    out[3] = float(mass[std::size_t(cell)] / plain.total);
+    out[4] = float(solidAngle[std::size_t(cell)]);
+  }
+  tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return tables;
 }

@@ -52,7 +52,16 @@ struct EnvmapTables {
   double bankBuildSeconds = 0;  // building every table from the map's luminance, or reading them (bankFromCache)
   bool bankFromCache = false;   // read from the bank cache (BankCache.h)
 
+  // The optimal pdf per pixel (kernels/pixel_optimal.h): > 0, the cells, blocks of
+  // 2^blockLog2 texels a side, laid out as the bank's; blockProbs then holds each
+  // cell's MA_CELL_FLOATS, and texels[4t + 3] is t's probability within its cell.
+  int pixelCells = 0;
+  int pixelCdfSteps = 0;  // ceil(log2(pixelCells)): searchPixelCdf's steps
+
   bool hasBank() const { return bankShares > 0; }
+  // The envmap technique's pdf depends on the stage's envmap share (bankEntryOf,
+  // buildPixelOptimalCdf): a stage of another α samples from another table.
+  bool followsEnvmapShare() const { return bankShares > 0 || pixelCells > 0; }
 };
 
 // Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B (compensated with
@@ -85,5 +94,19 @@ void writeBlockSlotTables(const std::vector<double>& weights, int width, int hei
 // sin θ. A black map falls back to plain (uniform) tables.
 EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
                                       const std::array<float, 3>& mirror, const OptimalBankOptions& options = {});
+
+// The optimal pdf per pixel's cells span at most this many blocks across the map: 16 × 8
+// cells of 22.5°, whose table a pixel builds each stage (docs/results.md, "The optimal
+// pdf per pixel").
+constexpr int kPixelCellsAcross = 16;
+
+// log2 of the cells' side in texels for a map `width` texels wide: at least 1.
+int pixelCellLog2(int width);
+constexpr int kMaxPixelCellLog2 = 12;
+
+// The optimal pdf per pixel's tables: cells of 2^pixelCellLog2 texels a side with their
+// centres, plain masses and solid angles; each cell's texels drawn by an alias table ∝
+// luminance × sin θ. A black map falls back to plain (uniform) tables.
+EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap);
 
 }  // namespace misalloc

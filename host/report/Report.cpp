@@ -36,10 +36,15 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
       pdf["fallback_reason"] = "no texel's luminance exceeds 2(1-C) times the mean (a constant map?)";
     pdf["zero_texel_fraction"] = tables.zeroTexelFraction;
   }
-  if (tables.requestedPdf.optimal()) {
-    pdf["fallback_to_plain"] = !tables.hasBank();
-    if (!tables.hasBank()) pdf["fallback_reason"] = "the map is black";
+  if (tables.requestedPdf.optimal() || tables.requestedPdf.pixelOptimal()) {
+    pdf["fallback_to_plain"] = !tables.followsEnvmapShare();
+    if (!tables.followsEnvmapShare()) pdf["fallback_reason"] = "the map is black";
   }
+  if (tables.pixelCells > 0)
+    pdf["pixel_cells"] = {{"cells", tables.pixelCells},
+                          {"cell_texels", 1 << (2 * tables.blockLog2)},
+                          {"table_bytes", (tables.aliasTable.size() + tables.blockProbs.size()) * 4},
+                          {"build_seconds", tables.bankBuildSeconds}};
   if (tables.hasBank()) {
     const BankVariances& v = tables.bankVariances;
     const std::size_t entries = std::size_t(tables.brdfBins) * tables.bankShares;

@@ -28,6 +28,10 @@ kern::EnvmapView makeEnvmapView(const EnvmapTables& t, float coskExponent) {
   env.blockProbs = t.blockProbs.data();
   env.brdfBin = 0;
   env.bankEntry = 0;
+  env.pixelCells = t.pixelCells;
+  env.pixelCdf = nullptr;
+  env.pixelCdfStride = 1;
+  env.pixelCdfSteps = t.pixelCdfSteps;
   return env;
 }
 
@@ -122,6 +126,13 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
                               config_.estimator == Estimator::OneSample,
                               config_.estimator == Estimator::CountIndependent, config_.risCandidates);
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
+    std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells));
+    if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
+      kern::buildPixelOptimalCdf(scene_.tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z,
+                                 sp.mirrorFrame.z, kern::stageEnvmapShare(ts.product.tables > 0, c), pixelCdf.data(),
+                                 1);
+      pixelEnv.pixelCdf = pixelCdf.data();
+    }
     kern::PixelSums sums = kern::zeroPixelSums();
     double* running = stats_.data() + kern::statsOffset(pixel, slots);
     for (int j = 0; j < kern::pixelStageSamples(c); ++j) {

@@ -23,7 +23,9 @@ bool SceneOptions::perPixelGeometry() const {
 
 EnvmapPdf defaultEnvmapPdf(const SceneOptions& options) {
   if (options.splitBrdf) return {};
-  return parseEnvmapPdf(options.perPixelGeometry() ? "compensated" : "optimal");
+  // The bank is built for one normal and view; per-pixel geometry builds its own tables
+  // (docs/results.md, "The optimal pdf per pixel").
+  return parseEnvmapPdf(options.perPixelGeometry() ? "optimal-pixel" : "optimal");
 }
 
 int SceneOptions::techniqueRole(int technique) const { return kern::techniqueRole(splitBrdf, product, technique); }
@@ -163,6 +165,14 @@ Scene makeScene(const SceneOptions& options) {
     }
     scene.tables =
         cached ? std::move(*cached) : buildOptimalEnvmapTables(scene.envmap, options.sampler, scene.grid, mirror);
+  } else if (options.envmapPdf.pixelOptimal()) {
+    if (options.splitBrdf)
+      throw InputError(
+          "--envmap-pdf optimal-pixel with --split-brdf: not implemented; eq. 9's q takes the BRDF as one "
+          "technique (M = 2)");
+    // Its own sampler whatever --envmap-sampler says: a cell by the pixel's CDF, a texel
+    // in it by the cell's alias table.
+    scene.tables = buildPixelOptimalEnvmapTables(scene.envmap);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }

@@ -70,20 +70,20 @@ Scene scene(const std::string& envmap, bool split, bool product, EnvmapSampler s
 // with every estimator) and its plainConfig, with either MIS weights where the run
 // takes them (render/RunChecks.h), at each work-group size, and the grid search where
 // the config asks for one (Sampler's constructor); not those of runs that
-// requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank (M = 2
-// only) on one map: the map changes MA_ANALYTIC_RADIANCE alone. Work-groups of the CPU's size and the
-// largest GPU's: the size changes the local arrays' lengths alone, which `clang -S`
-// does not hold against a device's limits. The product technique (M = 3 as with split
-// lobes, its tables' count compiled in) on one map. A CPU's samplePixelStage (alias
-// sampler, no resampling) at 8 and 16 lanes.
+// requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank and the
+// optimal pdf per pixel (M = 2 only) on one map: the map changes MA_ANALYTIC_RADIANCE alone. Work-groups of the CPU's
+// size and the largest GPU's: the size changes the local arrays' lengths alone, which `clang -S` does not hold against
+// a device's limits. The product technique (M = 3 as with split lobes, its tables' count compiled in) on one map. A
+// CPU's samplePixelStage (alias sampler, no resampling) at 8 and 16 lanes.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
-  for (const std::string pdf : {"plain", "optimal"})
+  for (const std::string pdf : {"plain", "optimal", "optimal-pixel"})
     for (int techniques : {0, 1, 2})  // the BRDF as one technique, split, or with the product
       for (EnvmapSampler sampler : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
         for (const std::string envmap : {"constant", "cosk:3"}) {
           const bool split = techniques == 1, product = techniques == 2;
-          if (pdf == "optimal" && (split || envmap != "constant")) continue;
+          if (pdf != "plain" && (split || envmap != "constant")) continue;
+          if (pdf == "optimal-pixel" && sampler == EnvmapSampler::Cdf) continue;  // its own sampler either way
           if (product && envmap != "constant") continue;
           Scene s = scene(envmap, split, product, sampler, pdf);
           for (Method method : allMethods())

@@ -1,0 +1,154 @@
+// The optimal envmap pdf of [Kar19] for one pixel's own normal, view, BRDF and envmap
+// share C, built at run time: every pixel may see the map differently (a real scene),
+// and C is the pixel's own α_0. The map is cut into coarse cells, blocks of 2^L × 2^L
+// texels (host/distributions/EnvmapDistribution.h, buildPixelOptimalEnvmapTables), each
+// with its centre, its share of the plain pdf's mass and its solid angle. Per pixel and
+// stage, f = L ρ cos and the BRDF technique's p_ρ are taken at each cell's centre and
+// the cells weighed by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its
+// bound s = 1/C, which the optimal pdf's bank measures within a few percent of eq. 9's
+// variance (render.json, one_sample_variance_eq6_over_eq9_mean). A share of the plain
+// pdf keeps every lit cell drawable (a cell whose centre is below the horizon may hold
+// lit texels above it). The pixel's CDF over the cells lives in its rows of local
+// memory (kernels/pixel_layout.h); a texel within the drawn cell comes from the cell's
+// alias table ∝ luminance × sin θ, as for the bank (kernels/envmap.h,
+// sampleEnvmapPixelCells). The pdf a sample is weighed with is read from the same CDF,
+// so the estimator is unbiased however coarse the cells are.
+//
+// The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them, so that a
+// work-group of one pixel (samplePixelStage) shares a pass among its lanes while its
+// sums keep the order that a single work-item and the C++ reference add them in.
+#include "namespace_check.h"
+#ifndef MA_PIXEL_OPTIMAL_H
+#define MA_PIXEL_OPTIMAL_H
+#include "envmap.h"
+#include "phong.h"
+#include "pixel_layout.h"
+
+// A cell's floats: its centre's direction x, y, z, its share of the plain pdf's mass,
+// its solid angle.
+#define MA_CELL_FLOATS 5
+// The plain pdf's share of the pixel's table: the defensive part.
+#define MA_PIXEL_PLAIN_SHARE 0.0625f
+
+// The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
+// count + 1 entries, as float bits, which hold each cell's f until the last pass; then
+// each cell's p_ρ mass; then per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms.
+#define MA_CDF_ROW(c) (c)
+#define MA_BRDF_ROW(count, c) ((count) + 1 + (c))
+enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
+#define MA_CHUNK_ROW(count, sum, j) (2 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
+
+MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
+MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
+
+MA_FN int chunkBegin(int count, int j) { return j * count / MA_PIXEL_CHUNKS; }
+
+// Pass 1, any cell in any order: f and p_ρ's mass at cell c.
+MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
+                                 MaVec3 mirror, MA_LOCAL int* rows, int stride) {
+  MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
+  MaVec3 w = makeVec3(cell[0], cell[1], cell[2]);
+  float lobe = phongLobe(b, w, mirror);
+  setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cell[3] * phongBrdf(b, lobe) * cosAboveSurface(normal, w));
+  setRowFloat(rows, stride, MA_BRDF_ROW(count, c), cell[4] * brdfPdf(b, normal, w, lobe));
+}
+
+// Pass 2, per chunk: its Σ f, Σ p_ρ and Σ plain.
+MA_FN void pixelOptimalChunkSums(MA_GLOBAL const float* cells, int count, int j, MA_LOCAL int* rows, int stride) {
+  float sumF = 0.0f, sumQ = 0.0f, sumPlain = 0.0f;
+  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
+    sumF += rowFloat(rows, stride, MA_CDF_ROW(c + 1));
+    sumQ += rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+    sumPlain += cells[MA_CELL_FLOATS * c + 3];
+  }
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j), sumF);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j), sumQ);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j), sumPlain);
+}
+
+MA_FN float chunkTotal(MA_LOCAL const int* rows, int stride, int count, int sum) {
+  float total = 0.0f;
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) total += rowFloat(rows, stride, MA_CHUNK_ROW(count, sum, j));
+  return total;
+}
+
+// Eq. 6's terms max(0, f/F − (1−C) p_ρ/B), C clamped to [0, 1].
+typedef struct {
+  float invF, brdfScale;
+  int lit;  // F > 0: else the table is the plain pdf's
+} PixelOptimalTerms;
+
+MA_FN PixelOptimalTerms pixelOptimalTerms(MA_LOCAL const int* rows, int stride, int count, float envmapShare) {
+  float F = chunkTotal(rows, stride, count, CHUNK_F), B = chunkTotal(rows, stride, count, CHUNK_BRDF);
+  float C = ma_min(ma_max(envmapShare, 0.0f), 1.0f);
+  PixelOptimalTerms t;
+  t.lit = F > 0.0f && F < INFINITY;
+  t.invF = t.lit ? 1.0f / F : 0.0f;
+  t.brdfScale = B > 0.0f && B < INFINITY ? (1.0f - C) / B : 0.0f;
+  return t;
+}
+
+MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
+  float v =
+      rowFloat(rows, stride, MA_CDF_ROW(c + 1)) * t.invF - t.brdfScale * rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+  return v > 0.0f ? v : 0.0f;
+}
+
+// Pass 3, per chunk: its Σ of eq. 6's terms.
+MA_FN void pixelOptimalChunkEq6(int count, int j, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
+  float mass = 0.0f;
+  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) mass += eq6Term(rows, stride, count, c, t);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j), mass);
+}
+
+// The table: (1 − d) eq. 6 / Σ eq. 6 + d plain / Σ plain, or the plain pdf alone where
+// the BRDF sees no light.
+typedef struct {
+  float optimal, plain;
+} PixelTableScales;
+
+MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
+  float mass = chunkTotal(rows, stride, count, CHUNK_EQ6), plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
+  float optimalShare = t.lit && mass > 0.0f ? 1.0f - MA_PIXEL_PLAIN_SHARE : 0.0f;
+  PixelTableScales s;
+  s.optimal = optimalShare > 0.0f ? optimalShare / mass : 0.0f;
+  s.plain = plain > 0.0f ? (1.0f - optimalShare) / plain : 0.0f;
+  return s;
+}
+
+MA_FN float chunkTableMass(MA_LOCAL const int* rows, int stride, int count, int j, PixelTableScales s) {
+  return s.optimal * rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)) +
+         s.plain * rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j));
+}
+
+// Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
+// offset the table mass of the chunks before it, each entry at most the next chunk's
+// ⌈offset⌉: the CDF never falls across a chunk's edge, however the sums round. The last
+// entry is 1.
+MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
+                                MA_LOCAL int* rows, int stride) {
+  float offset = 0.0f;
+  for (int i = 0; i < j; ++i) offset += chunkTableMass(rows, stride, count, i, s);
+  float next = ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, s), 1.0f));
+  float partial = 0.0f;
+  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
+    partial += s.optimal * eq6Term(rows, stride, count, c, t) + s.plain * cells[MA_CELL_FLOATS * c + 3];
+    float entry = ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next);
+    setRowFloat(rows, stride, MA_CDF_ROW(c + 1), c + 1 < count ? entry : 1.0f);
+  }
+  if (j == 0) setRowFloat(rows, stride, MA_CDF_ROW(0), 0.0f);
+}
+
+// The whole build by one work-item (sampleStage, the C++ reference): the pixel's CDF over
+// `count` cells at rows[r · stride], r = 0 … count, for a stage of envmap share C.
+MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
+                                float envmapShare, MA_LOCAL int* rows, int stride) {
+  for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkSums(cells, count, j, rows, stride);
+  PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkEq6(count, j, t, rows, stride);
+  PixelTableScales s = pixelTableScales(rows, stride, count, t);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, t, s, rows, stride);
+}
+
+#endif
