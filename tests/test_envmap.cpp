@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Constants.h"
@@ -482,6 +483,35 @@ TEST_CASE(
       CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
     }
   }
+}
+
+TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reaches, on any map's shape",
+          "[envmap][optimal]") {
+  // A map taller than wide would otherwise give 16 × 64 cells, beyond searchPixelCdf's
+  // 8 steps: the last cells could never be drawn, though the pdf counts them.
+  for (auto [width, height] : {std::pair{1024, 512}, std::pair{16, 1024}, std::pair{1, 4096}, std::pair{4096, 4096}}) {
+    const int log2 = misalloc::pixelCellLog2(width, height);
+    const int64_t across = (width + (1 << log2) - 1) >> log2, down = (height + (1 << log2) - 1) >> log2;
+    INFO(width << "x" << height << ": 2^" << log2 << " texels a side");
+    CHECK(log2 >= 1);
+    CHECK(across <= misalloc::kPixelCellsAcross);
+    CHECK(across * down <= MA_MAX_PIXEL_CELLS);
+  }
+  CHECK(misalloc::pixelCellLog2(1024, 512) == 6);  // 16 × 8 cells
+  // A tall map's texels are drawn with the probabilities the pdf gives them: 2 × 128
+  // cells of 8 × 8 texels, the most the search reaches.
+  const Envmap tall = greyMap(16, 1024, [](int col, int row) { return float(1 + (col + 3 * row) % 7); });
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(tall);
+  REQUIRE(tables.pixelCells == MA_MAX_PIXEL_CELLS);
+  kern::EnvmapView view = viewOf(tables);
+  std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells));
+  const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f,
+                             rows.data(), 1);
+  view.pixelCdf = rows.data();
+  std::vector<double> p(std::size_t(tables.width) * tables.height);
+  for (std::size_t t = 0; t < p.size(); ++t) p[t] = kern::texelProbability(view, int(t));
+  checkDrawnTexels(view, p, 200000, 0x7a1, 1, 0.001);
 }
 
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {

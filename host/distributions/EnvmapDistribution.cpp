@@ -335,10 +335,15 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   return tables;
 }
 
-int pixelCellLog2(int width) {
+int pixelCellLog2(int width, int height) {
   // At least 2 × 2 texels: sampleTexelInBlock draws a slot by a shift of 32 − 2L bits.
+  // At most MA_MAX_PIXEL_CELLS cells, which searchPixelCdf's steps reach, also on a map
+  // taller than the usual 2:1.
+  auto cells = [&](int log2) {
+    return int64_t((width + (1 << log2) - 1) >> log2) * ((height + (1 << log2) - 1) >> log2);
+  };
   int log2 = 1;
-  while (((width + (1 << log2) - 1) >> log2) > kPixelCellsAcross) ++log2;
+  while (((width + (1 << log2) - 1) >> log2) > kPixelCellsAcross || cells(log2) > MA_MAX_PIXEL_CELLS) ++log2;
   return log2;
 }
 
@@ -350,7 +355,7 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
   const PlainWeights plain = plainWeightsOf(image);
   EnvmapTables tables = blockDrawnTables(envmap, EnvmapSampler::Alias, plain, EnvmapPdf::Kind::PixelOptimal);
   if (!(plain.total > 0)) return tables;
-  const int log2 = tables.blockLog2 = pixelCellLog2(width);
+  const int log2 = tables.blockLog2 = pixelCellLog2(width, height);
   // A slot of a cell's alias table takes 2L of a draw's 32 bits, the rest are its coin.
   if (log2 > kMaxPixelCellLog2)
     throw InputError(fmt::format("envmap '{}' is {} texels wide: the optimal pdf per pixel takes at most {}",

@@ -100,8 +100,9 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
 // pdf per pixel").
 constexpr int kPixelCellsAcross = 16;
 
-// log2 of the cells' side in texels for a map `width` texels wide: at least 1.
-int pixelCellLog2(int width);
+// log2 of the cells' side in texels for a map of width × height texels: at least 1, with
+// at most kPixelCellsAcross cells across and MA_MAX_PIXEL_CELLS in all.
+int pixelCellLog2(int width, int height);
 constexpr int kMaxPixelCellLog2 = 12;
 
 // The optimal pdf per pixel's tables: cells of 2^pixelCellLog2 texels a side with their
