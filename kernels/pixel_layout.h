@@ -16,7 +16,7 @@ enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, S
 // optimal, the coefficients a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with
 // --product, its ProductMixture (diffuse, specular, specular table); then, with the
 // optimal pdf per pixel, its CDF over the cells and the build's scratch
-// (kernels/pixel_optimal.h, pixelOptimalRows).
+// (kernels/pixel_optimal.h, MA_PIXEL_CDF_ROWS).
 enum {
   ROW_RHO_D,
   ROW_RHO_S,

@@ -88,6 +88,7 @@ MA_FN PixelOptimalTerms pixelOptimalTerms(MA_LOCAL const int* rows, int stride, 
   return t;
 }
 
+// [Kar19] eq. 6 before normalisation, at cell c.
 MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
   float v =
       rowFloat(rows, stride, MA_CDF_ROW(c + 1)) * t.invF - t.brdfScale * rowFloat(rows, stride, MA_BRDF_ROW(count, c));
