@@ -8,6 +8,7 @@
 #include "common.h"
 #include "envmap.h"
 #include "phong.h"
+#include "pixel_optimal.h"
 #include "product.h"
 #include "rng.h"
 
@@ -41,7 +42,7 @@ typedef struct {
   int splitBrdf;                  // M = 3: the BRDF's lobes are techniques of their own
   ProductView product;            // product.tables > 0: technique 2 is the product technique
   ProductMixture productMixture;  // the pixel's (productMixture)
-  int sharePdfs;                  // 1: evaluateSample also gives the envmap's pdf under every share of the bank
+  int sharePdfs;                  // 1: evaluateSample also gives the envmap's pdf under every share's table
 } TechniqueSet;
 
 typedef struct {
@@ -107,8 +108,17 @@ MA_FN float mixturePdf(int techniqueCount, const float* alpha, const float* pdfs
 typedef struct {
   float r, g, b;  // f(ω_i) = L(ω_i) f_r(ω_o, ω_i) cos θ_i
   float pdfs[MA_MAX_TECHNIQUES];
-  float sharePdfs[MA_MAX_BANK_SHARES];  // TechniqueSet::sharePdfs: bankSharePdfs at ω_i, else 0
+  float sharePdfs[MA_MAX_BANK_SHARES];  // TechniqueSet::sharePdfs: envmapSharePdfs at ω_i, else 0
 } SampleValue;
+
+// The envmap's pdf at ω_i in texel t under the table of every share: the bank's entries
+// of the pixel's BRDF bin, or the tables the optimal pdf per pixel would build.
+MA_FN void envmapSharePdfs(EnvmapView env, ShadingPoint sp, int t, float sinTheta, float* pdfs) {
+  if (env.pixelCells > 0)
+    pixelSharePdfs(env, sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, t, sinTheta, pdfs);
+  else
+    bankSharePdfs(env, t, sinTheta, pdfs);
+}
 
 // f and every p_k at the direction that `technique` drew, in the texel it drew (as
 // sampleEnvmap says why) or the one that holds it. A constant `technique` folds the
@@ -129,7 +139,7 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, ShadingPoint s
   techniquePdfs(ts, env, sp, wi, texel, sinTheta, hit.pdf, lobe, s.pdfs);
   MA_UNROLL
   for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
-  if (ts.sharePdfs) bankSharePdfs(env, texel, sinTheta, s.sharePdfs);
+  if (ts.sharePdfs) envmapSharePdfs(env, sp, texel, sinTheta, s.sharePdfs);
   return s;
 }
 

@@ -52,7 +52,7 @@ MA_FN ma_uint firstIndexOf(StageCounts c, int technique) {
 
 typedef struct {
   int technique;
-  int share;      // the bank's share the stage's envmap samples draw with (bankShareOf); 0 without a bank
+  int share;      // the share column the stage's envmap samples draw with (stageShareColumn)
   float r, g, b;  // the sample's term of the stage estimate
   float w;        // its luminance value: Y(f)/p_α (balance), Y(f)/Σ_k p_k (count-independent),
                   // (1/M) Σ_i w_i (resampled)
@@ -92,6 +92,14 @@ MA_FN float stageEnvmapShare(int product, StageCounts c) {
   return bankEnvmapFraction(product, c.n0, c.n1, (float)c.n0 / (float)c.stageSamples);
 }
 
+// The share column whose table the stage's envmap samples draw with: the bank's entry's,
+// or for the optimal pdf per pixel the share nearest the stage's own C, which its table
+// is built for; 0 where there are no shares.
+MA_FN int stageShareColumn(EnvmapView env, int sharePdfs, float envmapFraction) {
+  int shares = env.bankShares > 0 ? env.bankShares : (sharePdfs && env.pixelCells > 0 ? MA_MAX_BANK_SHARES : 0);
+  return shares > 0 ? bankShareOf(shares, envmapFraction) : 0;
+}
+
 // The sample of `technique` with that technique's sample index `index`.
 MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, ShadingPoint sp, StageCounts c,
                                              int technique, ma_uint index, ma_uint seedLo, ma_uint seedHi,
@@ -129,7 +137,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Sh
   }
   SampleContribution out;
   out.technique = technique;
-  out.share = env.bankShares > 0 ? bankShareOf(env.bankShares, bankFraction) : 0;
+  out.share = stageShareColumn(env, ts.sharePdfs, bankFraction);
   out.r = s.r * invP / scale;
   out.g = s.g * invP / scale;
   out.b = s.b * invP / scale;
@@ -137,8 +145,13 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Sh
   out.w = out.y * invP;
   MA_UNROLL
   for (int k = 0; k < MA_MAX_TECHNIQUES; ++k) out.pdfs[k] = s.pdfs[k];
+  // The optimal pdf per pixel's stage table is built for its own C, not the column's:
+  // the column it draws with holds the pdf it was weighted with, so that the search's
+  // mixture of the drawn pdfs is the one that drew them.
+  int ownTable = env.pixelCells > 0 && ts.sharePdfs;
   MA_UNROLL
-  for (int k = 0; k < MA_MAX_BANK_SHARES; ++k) out.sharePdfs[k] = s.sharePdfs[k];
+  for (int k = 0; k < MA_MAX_BANK_SHARES; ++k)
+    out.sharePdfs[k] = ownTable && k == out.share ? s.pdfs[0] : s.sharePdfs[k];
   out.fr = s.r;
   out.fg = s.g;
   out.fb = s.b;

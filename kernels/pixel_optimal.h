@@ -17,6 +17,12 @@
 // The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them, so that a
 // work-group of one pixel (samplePixelStage) shares a pass among its lanes while its
 // sums keep the order that a single work-item and the C++ reference add them in.
+//
+// A stage that stores its samples for the grid search of `exact` (kernels/stats.h, share
+// columns) also keeps the scales of the tables that stages of the shares C = 1/4, 1/2,
+// 3/4 would build: each sample then carries its pdf under each, and the search judges
+// each α_0 by the table of the share nearest it ([Kar19] Sec. 10's joint choice of the
+// pdf and the allocation), as it does with the bank's entries.
 #include "namespace_check.h"
 #ifndef MA_PIXEL_OPTIMAL_H
 #define MA_PIXEL_OPTIMAL_H
@@ -37,20 +43,38 @@
 #define MA_BRDF_ROW(count, c) ((count) + 1 + (c))
 enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
 #define MA_CHUNK_ROW(count, sum, j) (2 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
+// Then, for the share columns, 1/F and per share its table's (1−C)/B, optimal and plain
+// scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows.
+enum {
+  SHARE_INV_F,
+  SHARE_BRDF_SCALE,
+  SHARE_OPTIMAL = SHARE_BRDF_SCALE + MA_MAX_BANK_SHARES,
+  SHARE_PLAIN = SHARE_OPTIMAL + MA_MAX_BANK_SHARES,
+  SHARE_ROWS = SHARE_PLAIN + MA_MAX_BANK_SHARES
+};
+#define MA_SHARE_ROW(count, q) (2 * (count) + 1 + CHUNK_SUMS * MA_PIXEL_CHUNKS + (q))
 
 MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
 MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
 
 MA_FN int chunkBegin(int count, int j) { return j * count / MA_PIXEL_CHUNKS; }
 
+MA_FN MaVec3 cellCentre(MA_GLOBAL const float* cell) { return makeVec3(cell[0], cell[1], cell[2]); }
+
+// f's mass at cell c: its plain mass times ρ cos at its centre.
+MA_FN float cellIntegrand(MA_GLOBAL const float* cells, int c, PhongParams b, MaVec3 normal, MaVec3 mirror) {
+  MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
+  MaVec3 w = cellCentre(cell);
+  return cell[3] * phongBrdf(b, phongLobe(b, w, mirror)) * cosAboveSurface(normal, w);
+}
+
 // Pass 1, any cell in any order: f and p_ρ's mass at cell c.
 MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
                                  MaVec3 mirror, MA_LOCAL int* rows, int stride) {
   MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  MaVec3 w = makeVec3(cell[0], cell[1], cell[2]);
-  float lobe = phongLobe(b, w, mirror);
-  setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cell[3] * phongBrdf(b, lobe) * cosAboveSurface(normal, w));
-  setRowFloat(rows, stride, MA_BRDF_ROW(count, c), cell[4] * brdfPdf(b, normal, w, lobe));
+  MaVec3 w = cellCentre(cell);
+  setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cellIntegrand(cells, c, b, normal, mirror));
+  setRowFloat(rows, stride, MA_BRDF_ROW(count, c), cell[4] * brdfPdf(b, normal, w, phongLobe(b, w, mirror)));
 }
 
 // Pass 2, per chunk: its Σ f, Σ p_ρ and Σ plain.
@@ -88,11 +112,14 @@ MA_FN PixelOptimalTerms pixelOptimalTerms(MA_LOCAL const int* rows, int stride, 
   return t;
 }
 
-// [Kar19] eq. 6 before normalisation, at cell c.
-MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
-  float v =
-      rowFloat(rows, stride, MA_CDF_ROW(c + 1)) * t.invF - t.brdfScale * rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+// [Kar19] eq. 6 before normalisation, for a cell's f and p_ρ masses.
+MA_FN float eq6Value(float f, float q, PixelOptimalTerms t) {
+  float v = f * t.invF - t.brdfScale * q;
   return v > 0.0f ? v : 0.0f;
+}
+
+MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
+  return eq6Value(rowFloat(rows, stride, MA_CDF_ROW(c + 1)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
 }
 
 // Pass 3, per chunk: its Σ of eq. 6's terms.
@@ -108,14 +135,21 @@ typedef struct {
   float optimal, plain;
 } PixelTableScales;
 
-MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
-  float mass = chunkTotal(rows, stride, count, CHUNK_EQ6), plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
+// The scales, given eq. 6's mass and the plain mass over all cells.
+MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plain) {
   float optimalShare = t.lit && mass > 0.0f ? 1.0f - MA_PIXEL_PLAIN_SHARE : 0.0f;
   PixelTableScales s;
   s.optimal = optimalShare > 0.0f ? optimalShare / mass : 0.0f;
   s.plain = plain > 0.0f ? (1.0f - optimalShare) / plain : 0.0f;
   return s;
 }
+
+MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
+  return tableScalesOf(t, chunkTotal(rows, stride, count, CHUNK_EQ6), chunkTotal(rows, stride, count, CHUNK_PLAIN));
+}
+
+// A cell's mass in the table, from its eq. 6 term and its plain mass.
+MA_FN float cellTableMass(PixelTableScales s, float eq6, float plain) { return s.optimal * eq6 + s.plain * plain; }
 
 MA_FN float chunkTableMass(MA_LOCAL const int* rows, int stride, int count, int j, PixelTableScales s) {
   return s.optimal * rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)) +
@@ -133,23 +167,68 @@ MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, 
   float next = ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, s), 1.0f));
   float partial = 0.0f;
   for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
-    partial += s.optimal * eq6Term(rows, stride, count, c, t) + s.plain * cells[MA_CELL_FLOATS * c + 3];
+    partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cells[MA_CELL_FLOATS * c + 3]);
     float entry = ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next);
     setRowFloat(rows, stride, MA_CDF_ROW(c + 1), c + 1 < count ? entry : 1.0f);
   }
   if (j == 0) setRowFloat(rows, stride, MA_CDF_ROW(0), 0.0f);
 }
 
+// The share columns' share s of MA_MAX_BANK_SHARES: C_s = (s+1)/(shares+1), the bank's
+// (bankShareOf, kernels/envmap.h).
+MA_FN float columnShare(int s) { return (float)(s + 1) / (float)(MA_MAX_BANK_SHARES + 1); }
+
+// Pass 3b, for the share columns, by one work-item while the rows still hold each cell's
+// f: 1/F, and per share its (1−C)/B and its table's scales, eq. 6's mass summed in cell
+// order. Only the search reads them: their tables need not be the stage's bit for bit.
+MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
+  float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
+  for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
+    PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, columnShare(s));
+    float mass = 0.0f;
+    for (int c = 0; c < count; ++c) mass += eq6Term(rows, stride, count, c, t);
+    PixelTableScales scales = tableScalesOf(t, mass, plain);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F), t.invF);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s), t.brdfScale);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_OPTIMAL + s), scales.optimal);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_PLAIN + s), scales.plain);
+  }
+}
+
 // The whole build by one work-item (sampleStage, the C++ reference): the pixel's CDF over
-// `count` cells at rows[r · stride], r = 0 … count, for a stage of envmap share C.
+// `count` cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
+// `shareColumns`, the share columns' scales too.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
-                                float envmapShare, MA_LOCAL int* rows, int stride) {
+                                float envmapShare, int shareColumns, MA_LOCAL int* rows, int stride) {
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkSums(cells, count, j, rows, stride);
   PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkEq6(count, j, t, rows, stride);
+  if (shareColumns) pixelOptimalShareScales(count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, t, s, rows, stride);
+}
+
+// The envmap's pdf at ω in texel t under the table of each share (stats.h's share
+// columns), from the scales pass 3b kept, the cell's f taken again and its p_ρ, which
+// the rows keep.
+MA_FN void pixelSharePdfs(EnvmapView env, PhongParams b, MaVec3 normal, MaVec3 mirror, int t, float sinTheta,
+                          float* pdfs) {
+  MA_LOCAL const int* rows = env.pixelCdf;
+  int count = env.pixelCells, stride = env.pixelCdfStride, c = blockOfTexel(env, t);
+  float f = cellIntegrand(env.blockProbs, c, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+  float plain = env.blockProbs[MA_CELL_FLOATS * c + 3], inCell = env.texels[4 * t + 3];
+  PixelOptimalTerms terms;
+  terms.invF = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F));
+  terms.lit = 1;
+  MA_UNROLL
+  for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
+    terms.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s));
+    PixelTableScales scales;
+    scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_OPTIMAL + s));
+    scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_PLAIN + s));
+    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, eq6Value(f, q, terms), plain), sinTheta);
+  }
 }
 
 #endif

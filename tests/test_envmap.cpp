@@ -41,6 +41,42 @@ constexpr double kGrid24 = 0x1p24;  // uniformFloat's values are k / 2^24
 // The view the renderer hands the kernels; the maps here keep their image radiance.
 kern::EnvmapView viewOf(const EnvmapTables& tables) { return misalloc::makeEnvmapView(tables, -1); }
 
+// Shading points of the optimal pdf per pixel: a head-on diffuse-and-glossy pixel, a
+// near-mirror lobe (n = 1e5) seen at a grazing angle from a tilted normal, a black BRDF
+// (the plain table), a normal facing the map's lower half, and the envmap shares at
+// both ends.
+struct PixelOptimalPoint {
+  const char* name;
+  kern::PhongParams brdf;
+  kern::MaVec3 normal, mirror;
+  float share;
+};
+
+std::vector<PixelOptimalPoint> pixelOptimalPoints() {
+  const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
+  const kern::MaVec3 tilted = kern::makeVec3(0.8660254f, 0, 0.5f);  // 60° from the zenith
+  const kern::MaVec3 grazing = kern::makeVec3(-0.0871557f, 0, 0.9961947f);
+  return {
+      {"head-on glossy", {0.5f, 0.5f, 20.0f}, up, up, 0.5f},
+      {"near-mirror n 1e5 from a tilted normal", {0.0f, 1.0f, 1e5f}, tilted, grazing, 0.25f},
+      {"black BRDF", {0.0f, 0.0f, 1.0f}, up, up, 0.5f},
+      {"normal facing down", {0.8f, 0.2f, 5.0f}, kern::makeVec3(0, 0, -1), kern::makeVec3(0, 0, -1), 0.75f},
+      {"envmap share 1", {0.3f, 0.7f, 50.0f}, tilted, up, 1.0f},
+      {"envmap share 0", {0.3f, 0.7f, 50.0f}, tilted, up, 0.0f},
+  };
+}
+
+// The view of `point`'s own table for a stage of envmap share C, in `rows`.
+kern::EnvmapView pixelOptimalView(const EnvmapTables& tables, const PixelOptimalPoint& point, float share,
+                                  bool shareColumns, std::vector<int>& rows) {
+  kern::EnvmapView view = viewOf(tables);
+  rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells), 0);
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror, share,
+                             shareColumns ? 1 : 0, rows.data(), 1);
+  view.pixelCdf = rows.data();
+  return view;
+}
+
 // The texel that kernels/envmap.h's sampleEnvmap picks for these random numbers.
 int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) { return kern::sampleEnvmap(view, r).texel; }
 
@@ -427,28 +463,10 @@ TEST_CASE(
     "the optimal pdf per pixel draws texels with the probabilities it evaluates, positive wherever the map is lit",
     "[envmap][optimal]") {
   // kernels/pixel_optimal.h: a cell by the pixel's own CDF, built from its normal, mirror
-  // direction, BRDF and envmap share, then a texel of the cell by the plain weights. A
-  // head-on diffuse-and-glossy pixel, a near-mirror lobe (n = 1e5) seen at a grazing
-  // angle from a tilted normal, a black BRDF (the plain table), a normal facing the
-  // map's lower half, and the envmap shares at both ends. A false alarm in any χ² test
-  // with probability 2 %.
-  struct Point {
-    const char* name;
-    kern::PhongParams brdf;
-    kern::MaVec3 normal, mirror;
-    float share;
-  };
-  const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
-  const kern::MaVec3 tilted = kern::makeVec3(0.8660254f, 0, 0.5f);  // 60° from the zenith
-  const kern::MaVec3 grazing = kern::makeVec3(-0.0871557f, 0, 0.9961947f);
-  const Point points[] = {
-      {"head-on glossy", {0.5f, 0.5f, 20.0f}, up, up, 0.5f},
-      {"near-mirror n 1e5 from a tilted normal", {0.0f, 1.0f, 1e5f}, tilted, grazing, 0.25f},
-      {"black BRDF", {0.0f, 0.0f, 1.0f}, up, up, 0.5f},
-      {"normal facing down", {0.8f, 0.2f, 5.0f}, kern::makeVec3(0, 0, -1), kern::makeVec3(0, 0, -1), 0.75f},
-      {"envmap share 1", {0.3f, 0.7f, 50.0f}, tilted, up, 1.0f},
-      {"envmap share 0", {0.3f, 0.7f, 50.0f}, tilted, up, 0.0f},
-  };
+  // direction, BRDF and envmap share, then a texel of the cell by the plain weights, at
+  // every shading point of pixelOptimalPoints. A false alarm in any χ² test with
+  // probability 2 %.
+  const std::vector<PixelOptimalPoint> points = pixelOptimalPoints();
   const double level = misalloc::test::sidakLevel(0.02, int(std::size(points) * testMaps().size()));
   for (const auto& [name, map] : testMaps()) {
     EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
@@ -461,13 +479,10 @@ TEST_CASE(
     REQUIRE(tables.pixelCells > 0);
     CHECK(tables.pixelCells <= MA_MAX_PIXEL_CELLS);
     const std::vector<double> plain = misalloc::plainTexelWeights(map.image);
-    for (const Point& point : points) {
+    for (const PixelOptimalPoint& point : points) {
       INFO(point.name);
-      kern::EnvmapView view = viewOf(tables);
-      std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells));
-      kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror,
-                                 point.share, rows.data(), 1);
-      view.pixelCdf = rows.data();
+      std::vector<int> rows;
+      kern::EnvmapView view = pixelOptimalView(tables, point, point.share, false, rows);
       std::vector<double> p(std::size_t(tables.width) * tables.height);
       double sum = 0;
       std::size_t unlit = 0;
@@ -478,9 +493,45 @@ TEST_CASE(
       // A cell's and a texel's probability, each rounded to float, and their product.
       CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
       CHECK(unlit == 0);
-      checkDrawnTexels(view, p, 200000, 0x9e1, uint32_t(&point - points), level);
+      checkDrawnTexels(view, p, 200000, 0x9e1, uint32_t(&point - points.data()), level);
       // The pdf a BRDF-sampled direction reads, by the midpoint rule.
       CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
+    }
+  }
+}
+
+TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables built for their shares",
+          "[envmap][optimal]") {
+  // The grid search of `exact` judges each α_0 by a stored sample's pdf under the share
+  // nearest it (kernels/stats.h's share columns), which pixelSharePdfs evaluates from
+  // scales kept beside the stage's own table. At every texel, each must be the pdf of the
+  // table that a stage of that share builds, up to the rounding of that table's CDF
+  // entries to the uniform's grid and the order of its sums.
+  for (const auto& [name, map] : testMaps()) {
+    EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
+    if (tables.pixelCells == 0) continue;  // the black map's plain tables
+    INFO(name);
+    for (const PixelOptimalPoint& point : pixelOptimalPoints()) {
+      INFO(point.name);
+      std::vector<int> stageRows;
+      const kern::EnvmapView stage = pixelOptimalView(tables, point, point.share, true, stageRows);
+      for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) {
+        INFO("share " << kern::columnShare(share));
+        std::vector<int> rows;
+        const kern::EnvmapView built = pixelOptimalView(tables, point, kern::columnShare(share), false, rows);
+        const float sinTheta = 0.5f, perProbability = kern::envmapPdfOfTexel(built, 1.0f, sinTheta);
+        std::size_t mismatches = 0, positive = 0;
+        for (int t = 0; t < tables.width * tables.height; ++t) {
+          float pdfs[MA_MAX_BANK_SHARES];
+          kern::pixelSharePdfs(stage, point.brdf, point.normal, point.mirror, t, sinTheta, pdfs);
+          const double expected = kern::envmapPdfOfTexel(built, kern::texelProbability(built, t), sinTheta);
+          const double slack = 1e-4 * expected + perProbability * tables.texels[4 * t + 3] * 4 * kFloatRounding;
+          mismatches += !(std::abs(pdfs[share] - expected) <= slack);
+          positive += expected > 0;
+        }
+        CHECK(mismatches == 0);
+        CHECK(positive > 0);
+      }
     }
   }
 }
@@ -506,7 +557,7 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   kern::EnvmapView view = viewOf(tables);
   std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells));
   const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
-  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f,
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 0,
                              rows.data(), 1);
   view.pixelCdf = rows.data();
   std::vector<double> p(std::size_t(tables.width) * tables.height);

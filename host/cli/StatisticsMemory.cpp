@@ -20,9 +20,12 @@ void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& 
                             int samplers) {
   const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
   const double pixels = double(scene.width) * scene.height;
-  // The columns of an optimal pdf's bank of every share (sampleColumns), from the
-  // options alone: at most what the scene's tables give.
-  const int shares = config.shareColumns && scene.envmapPdf.optimal() ? OptimalBankOptions{}.shares : 0;
+  // The columns of every share of an optimal pdf, the bank's or per pixel (sampleColumns),
+  // from the options alone: at most what the scene's tables give.
+  const int shares = !config.shareColumns             ? 0
+                     : scene.envmapPdf.optimal()      ? OptimalBankOptions{}.shares
+                     : scene.envmapPdf.pixelOptimal() ? MA_MAX_BANK_SHARES
+                                                      : 0;
   const double C = MA_STORED_COLUMNS(scene.techniqueCount(), shares);
   if (config.sampleCapacity > 0) {
     // A record per sample (kernels/stats.h), on a CPU device once in its buffer and

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "KernelCode.h"
 #include "distributions/AliasTable.h"
 #include "distributions/CompensatedPdf.h"
 #include "distributions/OptimalBank.h"
@@ -62,6 +63,9 @@ struct EnvmapTables {
   // The envmap technique's pdf depends on the stage's envmap share (bankEntryOf,
   // buildPixelOptimalCdf): a stage of another α samples from another table.
   bool followsEnvmapShare() const { return bankShares > 0 || pixelCells > 0; }
+  // The shares whose tables a stored sample's share columns may hold (kernels/stats.h):
+  // the bank's, or the three the optimal pdf per pixel evaluates (pixelSharePdfs).
+  int shareColumns() const { return bankShares > 0 ? bankShares : (pixelCells > 0 ? MA_MAX_BANK_SHARES : 0); }
 };
 
 // Texel weights are the luminance 0.2126 R + 0.7152 G + 0.0722 B (compensated with

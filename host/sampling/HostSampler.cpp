@@ -129,8 +129,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
       kern::buildPixelOptimalCdf(scene_.tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z,
-                                 sp.mirrorFrame.z, kern::stageEnvmapShare(ts.product.tables > 0, c), pixelCdf.data(),
-                                 1);
+                                 sp.mirrorFrame.z, kern::stageEnvmapShare(ts.product.tables > 0, c), ts.sharePdfs,
+                                 pixelCdf.data(), 1);
       pixelEnv.pixelCdf = pixelCdf.data();
     }
     kern::PixelSums sums = kern::zeroPixelSums();

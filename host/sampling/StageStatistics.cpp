@@ -57,8 +57,9 @@ StoredSamples StageStatistics::takeStoredSamples() {
 }
 
 SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config) {
-  const int M = scene.techniqueCount(), shares = scene.tables.bankShares;
-  const bool fits = shares > 0 && shares <= MA_MAX_BANK_SHARES && MA_STORED_COLUMNS(M, shares) <= MA_GRID_MAX_TECHNIQUES;
+  const int M = scene.techniqueCount(), shares = scene.tables.shareColumns();
+  const bool fits =
+      shares > 0 && shares <= MA_MAX_BANK_SHARES && MA_STORED_COLUMNS(M, shares) <= MA_GRID_MAX_TECHNIQUES;
   return SampleColumns(M, config.shareColumns && fits ? shares : 0);
 }
 
