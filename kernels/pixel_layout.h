@@ -43,8 +43,8 @@ enum {
   (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
 // The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
 // scratch, pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS), then
-// the scales of the tables of the share columns' shares, 1 + 3 per share
-// (MA_SHARE_SCALE_ROWS, for at most 3 shares: MA_MAX_BANK_SHARES).
+// the scales of the tables of the share columns' shares, 1 + 3 per share for at most 3
+// shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES).
 #define MA_PIXEL_CHUNKS 16
 #define MA_PIXEL_SHARE_ROWS 10
 #define MA_PIXEL_CDF_ROWS(pixelCells) \

@@ -152,8 +152,8 @@ MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, in
 MA_FN float cellTableMass(PixelTableScales s, float eq6, float plain) { return s.optimal * eq6 + s.plain * plain; }
 
 MA_FN float chunkTableMass(MA_LOCAL const int* rows, int stride, int count, int j, PixelTableScales s) {
-  return s.optimal * rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)) +
-         s.plain * rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j));
+  return cellTableMass(s, rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)),
+                       rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j)));
 }
 
 // Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
