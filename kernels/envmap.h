@@ -108,6 +108,14 @@ MA_FN float pixelCellProbability(EnvmapView env, int c) { return pixelCdfAt(env,
 // The most cells the pixel's CDF may have: searchPixelCdf takes at most 8 steps.
 #define MA_MAX_PIXEL_CELLS 256
 
+// A fixed-step binary search's steps written out as straight code, STEP(i) for each i:
+// a loop left in the sample loop, unrolled or not, keeps PoCL's sample loop scalar
+// (2–3× the time per sample; docs/pocl.md, rule 3). A step at or past the search's own
+// count is folded away where that count is a compile-time constant (the kernel's).
+#define MA_SEARCH_STEPS_8(STEP) STEP(0) STEP(1) STEP(2) STEP(3) STEP(4) STEP(5) STEP(6) STEP(7)
+#define MA_SEARCH_STEPS_16(STEP) \
+  MA_SEARCH_STEPS_8(STEP) STEP(8) STEP(9) STEP(10) STEP(11) STEP(12) STEP(13) STEP(14) STEP(15)
+
 // One step of searchPixelCdf, where the search has steps left.
 MA_FN void pixelCdfStep(EnvmapView env, int stepIndex, float u, int* base, int* n) {
   int step = *n >> 1;
@@ -117,18 +125,12 @@ MA_FN void pixelCdfStep(EnvmapView env, int stepIndex, float u, int* base, int* 
 }
 
 // The last cell c with cdf[c] ≤ u: searchCdf over the pixel's CDF. A cell of
-// probability 0 is never returned. Written out step by step: a loop left in the
-// sample loop, unrolled or not, kept PoCL's sample loop scalar (3× the time per sample).
+// probability 0 is never returned.
 MA_FN int searchPixelCdf(EnvmapView env, float u) {
   int base = 0, n = env.pixelCells;
-  pixelCdfStep(env, 0, u, &base, &n);
-  pixelCdfStep(env, 1, u, &base, &n);
-  pixelCdfStep(env, 2, u, &base, &n);
-  pixelCdfStep(env, 3, u, &base, &n);
-  pixelCdfStep(env, 4, u, &base, &n);
-  pixelCdfStep(env, 5, u, &base, &n);
-  pixelCdfStep(env, 6, u, &base, &n);
-  pixelCdfStep(env, 7, u, &base, &n);
+#define MA_PIXEL_CDF_STEP(i) pixelCdfStep(env, i, u, &base, &n);
+  MA_SEARCH_STEPS_8(MA_PIXEL_CDF_STEP)
+#undef MA_PIXEL_CDF_STEP
   return base;
 }
 
@@ -198,16 +200,25 @@ MA_FN int sampleAliasTable(MA_GLOBAL const ma_uint* table, ma_uint buckets, ma_u
   return coin < ma_as_float(lowWord(entry)) ? (int)bucket : (int)highWord(entry);
 }
 
-// The last index i in [0, n) with cdf[i] ≤ u, cdf[0] = 0 ≤ u < 1 = cdf[n]: a
-// branchless search with a fixed number of steps, so every work-item runs the same code.
+// The most steps searchCdf takes: a CDF over at most 65536 rows or columns.
+#define MA_MAX_CDF_STEPS 16
+
+// One step of searchCdf, where the search has steps left.
+MA_FN void cdfStep(MA_GLOBAL const float* cdf, int stepIndex, int steps, float u, int* base, int* n) {
+  int step = *n >> 1;
+  int take = stepIndex < steps && cdf[*base + step] <= u;
+  *base = take ? *base + step : *base;
+  *n = stepIndex < steps ? *n - step : *n;
+}
+
+// The last index i in [0, n) with cdf[i] ≤ u, cdf[0] = 0 ≤ u < 1 = cdf[n], for n ≤
+// 2^MA_MAX_CDF_STEPS: a branchless search of `steps` = ceil(log2(n)) steps, so every
+// work-item runs the same code.
 MA_FN int searchCdf(MA_GLOBAL const float* cdf, int n, int steps, float u) {
   int base = 0;
-  MA_UNROLL
-  for (int s = 0; s < steps; ++s) {
-    int step = n >> 1;
-    base = cdf[base + step] <= u ? base + step : base;
-    n -= step;
-  }
+#define MA_CDF_STEP(i) cdfStep(cdf, i, steps, u, &base, &n);
+  MA_SEARCH_STEPS_16(MA_CDF_STEP)
+#undef MA_CDF_STEP
   return base;
 }
 

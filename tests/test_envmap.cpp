@@ -256,6 +256,23 @@ TEST_CASE("kern::searchCdf returns the last index i with cdf[i] <= u", "[envmap]
   }
 }
 
+TEST_CASE("kern::searchCdf takes every written-out step up to MA_MAX_CDF_STEPS", "[envmap]") {
+  // A uniform CDF over n = 2^k entries, k = 10 … 16, each a multiple of 2^-k (exact in
+  // float): u = (i + f)/n lies in entry i, which only the search's last step decides
+  // for odd i.
+  for (int steps = 10; steps <= MA_MAX_CDF_STEPS; ++steps) {
+    const int n = 1 << steps;
+    std::vector<float> cdf(n + 1);
+    for (int i = 0; i <= n; ++i) cdf[i] = float(i) / float(n);
+    for (int i : {0, 1, n / 2 - 1, n / 2 + 1, n - 3, n - 1})
+      for (double f : {0.0, 0.5}) {
+        const float u = float((i + f) / n);
+        INFO("n = " << n << ", u = " << u);
+        CHECK(kern::searchCdf(cdf.data(), n, steps, u) == i);
+      }
+  }
+}
+
 TEST_CASE("buildEnvmapTables lays out the tables that kernels/envmap.h reads", "[envmap]") {
   Envmap map = greyMap(5, 3, [](int col, int row) { return float(1 + col + 10 * row); });
   map.image.rgb[0] = 7.0f;  // R of texel 0 differs from G and B
@@ -326,6 +343,14 @@ TEST_CASE("buildEnvmapTables rejects maps the kernels cannot index", "[envmap]")
   CHECK_THROWS_AS(misalloc::buildEnvmapTables(empty, EnvmapSampler::Alias), std::invalid_argument);
   Envmap negative = greyMap(2, 1, [](int col, int) { return col == 0 ? 1.0f : -1.0f; });
   CHECK_THROWS_AS(misalloc::buildEnvmapTables(negative, EnvmapSampler::Cdf), std::invalid_argument);
+  // The CDF sampler's search is written out for 2^MA_MAX_CDF_STEPS columns at most; the
+  // alias sampler takes a wider map.
+  const int widest = 1 << MA_MAX_CDF_STEPS;
+  Envmap wide = greyMap(widest + 1, 1, [](int, int) { return 1.0f; });
+  CHECK_THROWS_WITH(misalloc::buildEnvmapTables(wide, EnvmapSampler::Cdf),
+                    Contains(std::to_string(widest + 1) + " columns of texels") && Contains("alias"));
+  CHECK_NOTHROW(misalloc::buildEnvmapTables(wide, EnvmapSampler::Alias));
+  CHECK_NOTHROW(misalloc::buildEnvmapTables(greyMap(widest, 1, [](int, int) { return 1.0f; }), EnvmapSampler::Cdf));
 }
 
 TEST_CASE("texel probabilities sum to 1 and both samplers' agree", "[envmap]") {

@@ -157,6 +157,16 @@ int binarySearchSteps(int n) {
   return steps;
 }
 
+// searchCdf's steps over n rows or columns (`what`), which it writes out up to
+// MA_MAX_CDF_STEPS.
+int cdfSearchSteps(int n, const char* what) {
+  const int steps = binarySearchSteps(n);
+  if (steps > MA_MAX_CDF_STEPS)
+    throw InputError(fmt::format("--envmap-sampler cdf: {} {} exceed the CDF sampler's {}; use the alias sampler", n,
+                                 what, int64_t(1) << MA_MAX_CDF_STEPS));
+  return steps;
+}
+
 }  // namespace
 
 std::vector<uint32_t> interleave(const AliasTable& alias) {
@@ -248,8 +258,8 @@ EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, cons
   if (tables.useCdf) {
     tables.cdfTable = cdfTables(weights, image.width, image.height);
     tables.aliasTable = {0};
-    tables.cdfStepsRow = binarySearchSteps(image.height);
-    tables.cdfStepsCol = binarySearchSteps(image.width);
+    tables.cdfStepsRow = cdfSearchSteps(image.height, "rows of texels");
+    tables.cdfStepsCol = cdfSearchSteps(image.width, "columns of texels");
     storeDrawnProbabilities(tables.cdfTable.data(), image.width, image.height, tables.texels.data() + 3, 4);
   } else {
     tables.cdfTable = {0};
@@ -311,8 +321,8 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   tables.blockProbs.assign(entries * blocks, 0.0f);
   if (tables.useCdf) {
     tables.cdfTable.assign(entries * cdfSize, 0.0f);
-    tables.cdfStepsRow = binarySearchSteps(down);
-    tables.cdfStepsCol = binarySearchSteps(across);
+    tables.cdfStepsRow = cdfSearchSteps(down, "rows of blocks");
+    tables.cdfStepsCol = cdfSearchSteps(across, "columns of blocks");
   }
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::size_t e = 0; e < entries; ++e) {
