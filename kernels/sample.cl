@@ -358,10 +358,12 @@ MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* ce
   PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
   // The cells' terms in straight code, lane l taking cells l, L + l, ...: a loop left
   // here keeps PoCL from vectorising across the lanes (the lobe's exp and log dominate).
+  // Their stores are unconditional where the lanes divide the cells (docs/pocl.md, rule
+  // 9): a background pixel's rows are written too, and nothing reads them.
   MA_UNROLL
   for (int k = 0; k < (MA_PIXEL_CELLS + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES; ++k) {
     int c = k * MA_PIXEL_LANES + lid;
-    if (chunkEnd > 0 && c < MA_PIXEL_CELLS)
+    if (MA_PIXEL_CELLS % MA_PIXEL_LANES == 0 || c < MA_PIXEL_CELLS)
       pixelOptimalCellTerms(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror, rows, PIXEL_ROW_STRIDE);
   }
   barrier(CLK_LOCAL_MEM_FENCE);
