@@ -2,10 +2,11 @@
 // share C, built at run time: every pixel may see the map differently (a real scene),
 // and C is the pixel's own α_0. The map is cut into coarse cells, blocks of 2^L × 2^L
 // texels (host/distributions/EnvmapDistribution.h, buildPixelOptimalEnvmapTables), each
-// with its centre, its share of the plain pdf's mass and its solid angle. Per pixel and
-// stage, f = L ρ cos and the BRDF technique's p_ρ are taken at each cell's centre and
-// the cells weighed by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its
-// bound s = 1/C, which the optimal pdf's bank measures within a few percent of eq. 9's
+// with its centre, its share of the plain pdf's mass, its solid angle and its spread.
+// Per pixel and stage, f = L ρ cos and the BRDF technique's p_ρ are taken at each
+// cell's centre, their Phong lobe averaged over the cell (cellLobe), and the cells
+// weighed by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its bound s =
+// 1/C, which the optimal pdf's bank measures within a few percent of eq. 9's
 // variance (render.json, one_sample_variance_eq6_over_eq9_mean). A share of the plain
 // pdf keeps every lit cell drawable (a cell whose centre is below the horizon may hold
 // lit texels above it). The pixel's CDF over the cells lives in its rows of local
@@ -31,8 +32,8 @@
 #include "pixel_layout.h"
 
 // A cell's floats: its centre's direction x, y, z, its share of the plain pdf's mass,
-// its solid angle.
-#define MA_CELL_FLOATS 5
+// its solid angle, and its spread as a lobe's exponent (cellLobe).
+#define MA_CELL_FLOATS 6
 // The plain pdf's share of the pixel's table: the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
@@ -61,20 +62,33 @@ MA_FN int chunkBegin(int count, int j) { return j * count / MA_PIXEL_CHUNKS; }
 
 MA_FN MaVec3 cellCentre(MA_GLOBAL const float* cell) { return makeVec3(cell[0], cell[1], cell[2]); }
 
-// f's mass at cell c: its plain mass times ρ cos at its centre.
+// The Phong lobe averaged over a cell rather than taken at its centre: a lobe narrower
+// than the cell would otherwise weigh the cell by its tail at the centre, and a glossy
+// pixel's table would miss the cell that holds its lobe. cos^κ spreads a direction by
+// 1/κ per axis; the cell's κ is the inverse of its directions' second moment about its
+// centre along its wider axis (θ or φ: a cell at a pole is a narrow wedge), so that
+// cos^n about the mirror direction spread by the cell is cos^κ' with 1/κ' = 1/n + 1/κ
+// (variances add), scaled by (κ'+1)/(n+1) so that the lobe keeps its mass 2π/(n+1).
+MA_FN float cellLobe(PhongParams b, MA_GLOBAL const float* cell, MaVec3 mirror) {
+  PhongParams spread = b;
+  spread.n = b.n / (1.0f + b.n / cell[5]);  // κ = ∞ (a cell of one texel) spreads nothing
+  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, cellCentre(cell), mirror);
+}
+
+// f's mass at cell c: its plain mass times ρ (its lobe averaged over the cell) and cos
+// at its centre.
 MA_FN float cellIntegrand(MA_GLOBAL const float* cells, int c, PhongParams b, MaVec3 normal, MaVec3 mirror) {
   MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  MaVec3 w = cellCentre(cell);
-  return cell[3] * phongBrdf(b, phongLobe(b, w, mirror)) * cosAboveSurface(normal, w);
+  return cell[3] * phongBrdf(b, cellLobe(b, cell, mirror)) * cosAboveSurface(normal, cellCentre(cell));
 }
 
 // Pass 1, any cell in any order: f and p_ρ's mass at cell c.
 MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
                                  MaVec3 mirror, MA_LOCAL int* rows, int stride) {
   MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  MaVec3 w = cellCentre(cell);
   setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cellIntegrand(cells, c, b, normal, mirror));
-  setRowFloat(rows, stride, MA_BRDF_ROW(count, c), cell[4] * brdfPdf(b, normal, w, phongLobe(b, w, mirror)));
+  setRowFloat(rows, stride, MA_BRDF_ROW(count, c),
+              cell[4] * brdfPdf(b, normal, cellCentre(cell), cellLobe(b, cell, mirror)));
 }
 
 // Pass 2, per chunk: its Σ f, Σ p_ρ and Σ plain.

@@ -590,6 +590,59 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   checkDrawnTexels(view, p, 200000, 0x7a1, 1, 0.001);
 }
 
+TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell, not by its value at the centre",
+          "[envmap][optimal]") {
+  // kernels/pixel_optimal.h, cellLobe: summed over the cells, each cell's solid angle
+  // times its lobe keeps the lobe's mass 2π/(n+1). Up to the cells' quadrature (a few %)
+  // where the lobe is wider than a cell; where it is narrower, within what sampling a
+  // lobe of the cell's own spread at the cells' spacing allows (√12 spreads apart: 0.35–2.0
+  // on a square grid). The lobe's value at the centres misses a narrow lobe's mass by
+  // orders of magnitude, either way (0 or 200× at n = 10⁴): the case this exists for.
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", 1024));
+  REQUIRE(tables.pixelCells == 16 * 8);
+  auto cell = [&](int c) { return tables.blockProbs.data() + MA_CELL_FLOATS * c; };
+  auto centre = [&](int c) { return kern::cellCentre(cell(c)); };
+  auto normalised = [](double x, double y, double z) {
+    double r = std::sqrt(x * x + y * y + z * z);
+    return kern::makeVec3(float(x / r), float(y / r), float(z / r));
+  };
+  // A cell's centre, the corner that four cells share at the equator, and directions
+  // spread over the sphere by a fixed Fibonacci lattice.
+  const int c0 = 3 * 16 + 5;
+  const kern::MaVec3 a = centre(c0), b = centre(c0 + 1), c = centre(c0 + 16), d = centre(c0 + 17);
+  std::vector<kern::MaVec3> mirrors = {a,
+                                       normalised(a.x + b.x + c.x + d.x, a.y + b.y + c.y + d.y, a.z + b.z + c.z + d.z)};
+  for (int i = 0; i < 48; ++i) {
+    double z = 1 - (i + 0.5) / 24, r = std::sqrt(std::max(0.0, 1 - z * z)), phi = i * kPi * (3 - std::sqrt(5.0));
+    mirrors.push_back(normalised(r * std::cos(phi), r * std::sin(phi), z));
+  }
+  for (float n : {0.0f, 1.0f, 10.0f, 100.0f, 1e3f, 1e4f, 1e5f}) {
+    INFO("n = " << n);
+    const kern::PhongParams brdf = {0.0f, 1.0f, n};
+    for (const kern::MaVec3& mirror : mirrors) {
+      INFO("mirror " << mirror.x << ", " << mirror.y << ", " << mirror.z);
+      double mass = 0;
+      for (int k = 0; k < tables.pixelCells; ++k) mass += double(cell(k)[4]) * kern::cellLobe(brdf, cell(k), mirror);
+      const double ratio = mass / (2 * kPi / (double(n) + 1));
+      if (n <= 10.0f)
+        CHECK(std::abs(ratio - 1) <= 0.1);
+      else
+        CHECK((ratio >= 0.3 && ratio <= 2.5));
+    }
+  }
+  // On every test map, down to cells of one texel (no spread), the lobe is a number.
+  for (const auto& [name, map] : testMaps()) {
+    INFO(name);
+    EnvmapTables small = misalloc::buildPixelOptimalEnvmapTables(map);
+    for (int k = 0; k < small.pixelCells; ++k)
+      for (float n : {0.0f, 1.0f, 1e5f}) {
+        const float* c = small.blockProbs.data() + MA_CELL_FLOATS * k;
+        const float lobe = kern::cellLobe({0.0f, 1.0f, n}, c, kern::cellCentre(c));
+        CHECK((std::isfinite(lobe) && lobe > 0.0f));
+      }
+  }
+}
+
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {
   // Up to the float rounding of (col + u) / W and of the direction's components.
   const double slack = 8 * kFloatRounding * 2 * kPi;

@@ -20,6 +20,13 @@ namespace {
 
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
 
+// Texel i's centre less the centre of its cell's texels, in texels, along an axis of n
+// texels cut into cells of `side` (the last cell may be shorter).
+double offsetFromCellCentre(int i, int side, int n) {
+  const int first = i / side * side;
+  return i + 0.5 - (first + 0.5 * std::min(side, n - first));
+}
+
 void requireValidSize(const Envmap& envmap) {
   const RgbImage& image = envmap.image;
   // kernels/envmap.h indexes the texels' floats as int 4·t.
@@ -375,21 +382,29 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
   tables.pixelCells = across * down;
   tables.pixelCdfSteps = binarySearchSteps(tables.pixelCells);
 
-  // Per cell: the plain mass and the solid angle, each a sum over its texels.
+  // Per cell: the plain mass, the solid angle, and the second moments of its directions
+  // about its centre along θ and along φ (arc lengths), each a sum over its texels.
   std::vector<double> mass(std::size_t(tables.pixelCells), 0.0), solidAngle(mass.size(), 0.0);
+  std::vector<double> momentTheta(mass.size(), 0.0), momentPhi(mass.size(), 0.0);
   const double texelArea = (2 * kPi / width) * (kPi / height);  // dω = sin θ dφ dθ
   for (int row = 0; row < height; ++row) {
     const double sinTheta = sinThetaOfRow(row, height);
+    const double dTheta = kPi / height * offsetFromCellCentre(row, side, height);
     for (int col = 0; col < width; ++col) {
       const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinTheta;
       mass[cell] += plain.weights[std::size_t(row) * width + col];
       solidAngle[cell] += sinTheta * texelArea;
+      momentTheta[cell] += sinTheta * texelArea * dTheta * dTheta;
+      momentPhi[cell] += sinTheta * texelArea * dPhi * dPhi;
     }
   }
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
-  // Cells: the centre of the texels they hold, the plain mass, the solid angle.
+  // Cells: the centre of the texels they hold, the plain mass, the solid angle, and the
+  // exponent of a lobe as wide as the cell along its wider axis (cellLobe; ∞ for a cell
+  // of one texel).
   tables.blockProbs.assign(std::size_t(tables.pixelCells) * MA_CELL_FLOATS, 0.0f);
   for (int cell = 0; cell < tables.pixelCells; ++cell) {
     const int col0 = (cell % across) * side, row0 = (cell / across) * side;
@@ -402,6 +417,8 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
     out[2] = centre.z;
     out[3] = float(mass[std::size_t(cell)] / plain.total);
     out[4] = float(solidAngle[std::size_t(cell)]);
+    out[5] =
+        float(solidAngle[std::size_t(cell)] / std::max(momentTheta[std::size_t(cell)], momentPhi[std::size_t(cell)]));
   }
   tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
