@@ -53,10 +53,15 @@ MA_FN float diffuseLobeWeight(PhongParams b) {
   return albedo > 0.0f ? b.rhoD / albedo : 1.0f;
 }
 
-// BRDF×cos technique: the albedo-weighted mixture of the two lobes.
-MA_FN float brdfPdf(PhongParams b, MaVec3 normal, MaVec3 wi, float lobe) {
+// BRDF×cos technique: the albedo-weighted mixture of the two lobes, given cos θ_i
+// clamped at the horizon and the Phong lobe's cos^n α.
+MA_FN float brdfPdfOf(PhongParams b, float cosAbove, float lobe) {
   float wd = diffuseLobeWeight(b);
-  return wd * diffusePdf(normal, wi) + (1.0f - wd) * specularPdf(b, lobe);
+  return wd * (cosAbove * MA_INV_PI) + (1.0f - wd) * specularPdf(b, lobe);
+}
+
+MA_FN float brdfPdf(PhongParams b, MaVec3 normal, MaVec3 wi, float lobe) {
+  return brdfPdfOf(b, cosAboveSurface(normal, wi), lobe);
 }
 
 // An orthonormal basis t, s, z about a unit vector z (Duff et al. 2017, branch-free):

@@ -4,16 +4,16 @@
 // texels (host/distributions/EnvmapDistribution.h, buildPixelOptimalEnvmapTables), each
 // with its centre, its share of the plain pdf's mass, its solid angle and its spread.
 // Per pixel and stage, f = L ρ cos and the BRDF technique's p_ρ are taken at each
-// cell's centre, their Phong lobe averaged over the cell (cellLobe), and the cells
-// weighed by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its bound s =
-// 1/C, which the optimal pdf's bank measures within a few percent of eq. 9's
-// variance (render.json, one_sample_variance_eq6_over_eq9_mean). A share of the plain
-// pdf keeps every lit cell drawable (a cell whose centre is below the horizon may hold
-// lit texels above it). The pixel's CDF over the cells lives in its rows of local
-// memory (kernels/pixel_layout.h); a texel within the drawn cell comes from the cell's
-// alias table ∝ luminance × sin θ, as for the bank (kernels/envmap.h,
-// sampleEnvmapPixelCells). The pdf a sample is weighed with is read from the same CDF,
-// so the estimator is unbiased however coarse the cells are.
+// cell's centre, their Phong lobe and cosine averaged over the cell (cellLobe,
+// cellCosine), and the cells weighed by eq. 6, max(0, f − (1−C) p_ρ) with both
+// normalised: eq. 9 at its bound s = 1/C, which the optimal pdf's bank measures within
+// a few percent of eq. 9's variance (render.json, one_sample_variance_eq6_over_eq9_mean).
+// A share of the plain pdf keeps every lit cell drawable (the cells' means are
+// estimates: a cell weighed 0 may hold lit texels above the horizon). The pixel's CDF
+// over the cells lives in its rows of local memory (kernels/pixel_layout.h); a texel
+// within the drawn cell comes from the cell's alias table ∝ luminance × sin θ, as for
+// the bank (kernels/envmap.h, sampleEnvmapPixelCells). The pdf a sample is weighed with
+// is read from the same CDF, so the estimator is unbiased however coarse the cells are.
 //
 // The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them, so that a
 // work-group of one pixel (samplePixelStage) shares a pass among its lanes while its
@@ -75,11 +75,20 @@ MA_FN float cellLobe(PhongParams b, MA_GLOBAL const float* cell, MaVec3 mirror) 
   return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, cellCentre(cell), mirror);
 }
 
-// f's mass at cell c: its plain mass times ρ (its lobe averaged over the cell) and cos
-// at its centre.
+// max(0, cos θ) averaged over a cell rather than taken at its centre, so that a cell
+// that straddles the horizon keeps the part above it: the angle above the horizon
+// spread uniformly by ±w about the centre's, w = √(3/κ) (the cell's spread), in its
+// small-angle form: the centre's value where the cell lies wholly above, 0 below.
+MA_FN float cellCosine(MaVec3 normal, MA_GLOBAL const float* cell) {
+  float c = dot3(normal, cellCentre(cell)), w = ma_sqrt(3.0f / cell[5]);
+  float straddling = (c + w) * (c + w) / (4.0f * w);
+  return c >= w ? c : c > -w ? straddling : 0.0f;
+}
+
+// f's mass at cell c: its plain mass times ρ and cos, each averaged over the cell.
 MA_FN float cellIntegrand(MA_GLOBAL const float* cells, int c, PhongParams b, MaVec3 normal, MaVec3 mirror) {
   MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  return cell[3] * phongBrdf(b, cellLobe(b, cell, mirror)) * cosAboveSurface(normal, cellCentre(cell));
+  return cell[3] * phongBrdf(b, cellLobe(b, cell, mirror)) * cellCosine(normal, cell);
 }
 
 // Pass 1, any cell in any order: f and p_ρ's mass at cell c.
@@ -88,7 +97,7 @@ MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c,
   MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
   setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cellIntegrand(cells, c, b, normal, mirror));
   setRowFloat(rows, stride, MA_BRDF_ROW(count, c),
-              cell[4] * brdfPdf(b, normal, cellCentre(cell), cellLobe(b, cell, mirror)));
+              cell[4] * brdfPdfOf(b, cellCosine(normal, cell), cellLobe(b, cell, mirror)));
 }
 
 // Pass 2, per chunk: its Σ f, Σ p_ρ and Σ plain.
