@@ -364,6 +364,35 @@ int pixelCellLog2(int width, int height) {
   return log2;
 }
 
+namespace {
+
+// Per cell of 2^log2 texels a side: the exponent κ of a cos^κ lobe as wide as the cell
+// along its wider axis, the inverse of the second moment of its directions about its
+// centre along θ or along φ (arc lengths), whichever is larger (kernels/pixel_optimal.h,
+// cellLobe); ∞ for a cell of one texel.
+std::vector<float> cellSpreads(int width, int height, int log2) {
+  const int side = 1 << log2, across = (width + side - 1) / side, down = (height + side - 1) / side;
+  std::vector<double> solidAngle(std::size_t(across) * down, 0.0), theta(solidAngle.size(), 0.0),
+      phi(solidAngle.size(), 0.0);
+  const double texelArea = (2 * kPi / width) * (kPi / height);
+  for (int row = 0; row < height; ++row) {
+    const double dOmega = sinThetaOfRow(row, height) * texelArea;
+    const double dTheta = kPi / height * offsetFromCellCentre(row, side, height);
+    for (int col = 0; col < width; ++col) {
+      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinThetaOfRow(row, height);
+      solidAngle[cell] += dOmega;
+      theta[cell] += dOmega * dTheta * dTheta;
+      phi[cell] += dOmega * dPhi * dPhi;
+    }
+  }
+  std::vector<float> spreads(solidAngle.size());
+  for (std::size_t c = 0; c < spreads.size(); ++c) spreads[c] = float(solidAngle[c] / std::max(theta[c], phi[c]));
+  return spreads;
+}
+
+}  // namespace
+
 EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
   requireValidSize(envmap);
   const RgbImage& image = envmap.image;
@@ -382,29 +411,22 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
   tables.pixelCells = across * down;
   tables.pixelCdfSteps = binarySearchSteps(tables.pixelCells);
 
-  // Per cell: the plain mass, the solid angle, and the second moments of its directions
-  // about its centre along θ and along φ (arc lengths), each a sum over its texels.
+  // Per cell: the plain mass and the solid angle, each a sum over its texels.
   std::vector<double> mass(std::size_t(tables.pixelCells), 0.0), solidAngle(mass.size(), 0.0);
-  std::vector<double> momentTheta(mass.size(), 0.0), momentPhi(mass.size(), 0.0);
   const double texelArea = (2 * kPi / width) * (kPi / height);  // dω = sin θ dφ dθ
   for (int row = 0; row < height; ++row) {
     const double sinTheta = sinThetaOfRow(row, height);
-    const double dTheta = kPi / height * offsetFromCellCentre(row, side, height);
     for (int col = 0; col < width; ++col) {
       const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
-      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinTheta;
       mass[cell] += plain.weights[std::size_t(row) * width + col];
       solidAngle[cell] += sinTheta * texelArea;
-      momentTheta[cell] += sinTheta * texelArea * dTheta * dTheta;
-      momentPhi[cell] += sinTheta * texelArea * dPhi * dPhi;
     }
   }
+  const std::vector<float> spreads = cellSpreads(width, height, log2);
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
-  // Cells: the centre of the texels they hold, the plain mass, the solid angle, and the
-  // exponent of a lobe as wide as the cell along its wider axis (cellLobe; ∞ for a cell
-  // of one texel).
+  // Cells: the centre of the texels they hold, the plain mass, the solid angle, the spread.
   tables.blockProbs.assign(std::size_t(tables.pixelCells) * MA_CELL_FLOATS, 0.0f);
   for (int cell = 0; cell < tables.pixelCells; ++cell) {
     const int col0 = (cell % across) * side, row0 = (cell / across) * side;
@@ -417,8 +439,7 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
     out[2] = centre.z;
     out[3] = float(mass[std::size_t(cell)] / plain.total);
     out[4] = float(solidAngle[std::size_t(cell)]);
-    out[5] =
-        float(solidAngle[std::size_t(cell)] / std::max(momentTheta[std::size_t(cell)], momentPhi[std::size_t(cell)]));
+    out[5] = spreads[std::size_t(cell)];
   }
   tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
