@@ -39,8 +39,10 @@ MA_FN float phongBrdf(PhongParams b, float lobe) {
 // cos θ_i against the normal, 0 below the surface.
 MA_FN float cosAboveSurface(MaVec3 normal, MaVec3 wi) { return ma_max(dot3(normal, wi), 0.0f); }
 
-// Cosine lobe: p = cos θ / π on the upper hemisphere.
-MA_FN float diffusePdf(MaVec3 normal, MaVec3 wi) { return cosAboveSurface(normal, wi) * MA_INV_PI; }
+// Cosine lobe: p = cos θ / π on the upper hemisphere, given cos θ clamped at the horizon.
+MA_FN float diffusePdfOf(float cosAbove) { return cosAbove * MA_INV_PI; }
+
+MA_FN float diffusePdf(MaVec3 normal, MaVec3 wi) { return diffusePdfOf(cosAboveSurface(normal, wi)); }
 
 // Phong lobe about the mirror direction: p = (n+1)/(2π) cos^n α. Part of it may lie
 // below the horizon; such samples contribute zero but count.
@@ -57,7 +59,7 @@ MA_FN float diffuseLobeWeight(PhongParams b) {
 // clamped at the horizon and the Phong lobe's cos^n α.
 MA_FN float brdfPdfOf(PhongParams b, float cosAbove, float lobe) {
   float wd = diffuseLobeWeight(b);
-  return wd * (cosAbove * MA_INV_PI) + (1.0f - wd) * specularPdf(b, lobe);
+  return wd * diffusePdfOf(cosAbove) + (1.0f - wd) * specularPdf(b, lobe);
 }
 
 MA_FN float brdfPdf(PhongParams b, MaVec3 normal, MaVec3 wi, float lobe) {

@@ -366,22 +366,20 @@ int pixelCellLog2(int width, int height) {
 
 namespace {
 
-// Per cell of 2^log2 texels a side: the exponent κ of a cos^κ lobe as wide as the cell
-// along its wider axis, the inverse of the second moment of its directions about its
-// centre along θ or along φ (arc lengths), whichever is larger (kernels/pixel_optimal.h,
-// cellLobe); ∞ for a cell of one texel.
-std::vector<float> cellSpreads(int width, int height, int log2) {
-  const int side = 1 << log2, across = (width + side - 1) / side, down = (height + side - 1) / side;
-  std::vector<double> solidAngle(std::size_t(across) * down, 0.0), theta(solidAngle.size(), 0.0),
-      phi(solidAngle.size(), 0.0);
+// Per cell of 2^log2 texels a side, given its solid angle: the exponent κ of a cos^κ
+// lobe as wide as the cell along its wider axis, the inverse of the second moment of
+// its directions about its centre along θ or along φ (arc lengths), whichever is larger
+// (kernels/pixel_optimal.h, cellLobe); ∞ for a cell of one texel.
+std::vector<float> cellSpreads(int width, int height, int log2, const std::vector<double>& solidAngle) {
+  const int side = 1 << log2, across = (width + side - 1) / side;
+  std::vector<double> theta(solidAngle.size(), 0.0), phi(solidAngle.size(), 0.0);
   const double texelArea = (2 * kPi / width) * (kPi / height);
   for (int row = 0; row < height; ++row) {
-    const double dOmega = sinThetaOfRow(row, height) * texelArea;
+    const double sinTheta = sinThetaOfRow(row, height), dOmega = sinTheta * texelArea;
     const double dTheta = kPi / height * offsetFromCellCentre(row, side, height);
     for (int col = 0; col < width; ++col) {
       const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
-      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinThetaOfRow(row, height);
-      solidAngle[cell] += dOmega;
+      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinTheta;
       theta[cell] += dOmega * dTheta * dTheta;
       phi[cell] += dOmega * dPhi * dPhi;
     }
@@ -422,7 +420,7 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
       solidAngle[cell] += sinTheta * texelArea;
     }
   }
-  const std::vector<float> spreads = cellSpreads(width, height, log2);
+  const std::vector<float> spreads = cellSpreads(width, height, log2, solidAngle);
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
