@@ -58,6 +58,15 @@ TEST_CASE("a launch's work is each work-group's largest count per technique", "[
         std::vector<double>{2 * 2 + 2 * 4, 2 * 3 + 2 * 0});
 }
 
+TEST_CASE("a launch leaves out the pixels that take no samples", "[costmodel]") {
+  // Pixels 1 and 3 take none (the background): the launch runs pixels 2 and 0, one group
+  // of three that runs (3, 3), not the groups (1, 3, 2) and (0) that run (1, 3) and (3, 1).
+  const StagePlan plan = planOf({{3, 1}, {0, 0}, {1, 3}, {0, 0}}, true);
+  CHECK(coherentPixelOrder(plan, {0, 4}) == std::vector<int32_t>{2, 0});
+  CHECK(coherentPixelOrder(plan, {1, 2}).empty());
+  CHECK(launchWork(plan, Estimator::MultiSample, 3).slots == std::vector<double>{3 * 3, 3 * 3});
+}
+
 TEST_CASE("one pixel per work-group runs each count rounded up to the lanes", "[costmodel]") {
   // Lanes of 4: 9 → 12, 7 → 8, 0 → 0, 16 → 16; the group size does not matter.
   const StagePlan plan = planOf({{9, 7}, {0, 16}});

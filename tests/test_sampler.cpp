@@ -137,6 +137,49 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
   }
 }
 
+// A stage launches only the pixels that take samples (sampling/LaunchWork.h,
+// coherentPixelOrder). The others' sums are zero, not what an earlier stage left in the
+// device's buffers, and their running sums and stored samples stay as they were: the
+// C++ reference, which visits every pixel, bit for bit. With and without running sums
+// (sampleStage; samplePixelStage on a CPU), on scenes of per-pixel frames.
+TEST_CASE("pixels that take no samples in a stage are left out of its launch and sum to zero", "[sampler]") {
+  for (const SamplerConfig config :
+       {SamplerConfig{Estimator::MultiSample, 0, 0}, SamplerConfig{Estimator::MultiSample, MA_STATS_TECHNIQUE, 40}})
+    for (const std::string pdf : {"plain", "optimal-pixel"}) {
+      Scene scene = smallScene("venice_sunset", "seed000", 24, 16, false, EnvmapSampler::Alias, 0, pdf);
+      giveRandomFrames(scene, 3);
+      const int M = scene.techniqueCount(), pixels = scene.pixelCount();
+      Sampler device(testDevice(), scene, config);
+      HostSampler host(scene, config);
+      StagePlan every = singleStagePlan(scene, Method::Equal, 20);
+      device.run(every, 5);
+      host.run(every, 5);
+      // Every third pixel takes no samples in the second stage, whose first indices follow the first's.
+      StagePlan some = every;
+      for (int p = 0; p < pixels; ++p)
+        for (int k = 0; k < M; ++k) {
+          const size_t i = size_t(p) * M + k;
+          some.firstIndex[i] = uint32_t(every.counts[i]);
+          if (p % 3 == 0) some.counts[i] = 0;
+        }
+      const StageResult a = device.run(some, 5), b = host.run(some, 5);
+      size_t nonzero = 0, mismatches = 0;
+      for (int p = 0; p < pixels; p += 3) {
+        for (int c = 0; c < 3; ++c) nonzero += a.rgb[size_t(p) * 3 + c] != 0;
+        for (int k = 0; k < 2 * M; ++k) nonzero += a.moments[size_t(p) * 2 * M + k] != 0;
+      }
+      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+      const std::vector<double> statsA = device.statistics(), statsB = host.statistics();
+      for (size_t i = 0; i < statsA.size(); ++i) mismatches += statsA[i] != statsB[i];
+      const std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
+      for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
+      INFO(pdf << ", running sums " << config.statsMask << ", stored samples " << config.sampleCapacity);
+      CHECK(nonzero == 0);
+      CHECK(mismatches == 0);
+    }
+}
+
 // With share columns, a stored sample holds the envmap's pdf under each share's table,
 // the bank's or the optimal pdf per pixel's; the share its stage drew with must hold
 // exactly the pdf the sample was weighted with, and the rest of the record must be what a

@@ -1,13 +1,14 @@
 #include "sampling/LaunchWork.h"
 
 #include <algorithm>
-#include <numeric>
 
 namespace misalloc {
 
 std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
-  std::vector<int32_t> order(range.size());
-  std::iota(order.begin(), order.end(), range.begin);
+  std::vector<int32_t> order;
+  order.reserve(size_t(range.size()));
+  for (int p = range.begin; p < range.end; ++p)
+    if (takesSamples(plan, p)) order.push_back(p);
   const size_t M = size_t(plan.techniqueCount);
   auto before = [&](int32_t a, int32_t b) {
     const int* countsA = plan.counts.data() + size_t(a) * M;
@@ -43,10 +44,11 @@ LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize,
     return work;
   }
   const std::vector<int32_t> order = coherentPixelOrder(plan, {0, pixels});
-  for (int first = 0; first < pixels; first += groupSize)
+  const int launched = int(order.size());
+  for (int first = 0; first < launched; first += groupSize)
     for (int k = 0; k < M; ++k) {
       int largest = 0;
-      for (int i = first; i < std::min(pixels, first + groupSize); ++i)
+      for (int i = first; i < std::min(launched, first + groupSize); ++i)
         largest = std::max(largest, int(plan.counts[size_t(order[i]) * M + k]));
       work.slots[k] += double(groupSize) * largest;
     }

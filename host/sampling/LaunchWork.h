@@ -12,8 +12,18 @@ namespace misalloc {
 // technique's loop for its largest count (kernels/sample.cl, sampleStage), so pixels
 // with like counts share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort,
 // ties by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its
-// work-group, so the order changes the time only, never the result.
+// work-group, so the order changes the time only, never the result. Pixels that take
+// no samples this stage (the background) are left out: a launch of them would write
+// zero sums and cost a work-group each, and the caller writes those zeros itself.
 std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range);
+
+// Whether pixel `p` takes samples in this stage.
+inline bool takesSamples(const StagePlan& plan, int p) {
+  const int32_t* counts = plan.counts.data() + size_t(p) * size_t(plan.techniqueCount);
+  for (int k = 0; k < plan.techniqueCount; ++k)
+    if (counts[k] > 0) return true;
+  return false;
+}
 
 // What one launch executes: per technique, the sample slots Σ over work-groups of
 // (group size) · (the group's largest n_k), padding work-items included: a work-item

@@ -121,10 +121,11 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       cl::Kernel(buildProgram(device, "sample.cl", plainOptions), pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
   kernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl", statisticsOptions), "sampleStage")
                                     : plainKernel_;
-  launchIdentity_ = fmt::format("{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}", device.name(),
-                                device.device.getInfo<CL_DRIVER_VERSION>(),
-                                device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), embeddedSourcesHash(),
-                                plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
+  launchIdentity_ = fmt::format(
+      "{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}; "
+      "launches the pixels that take samples",
+      device.name(), device.device.getInfo<CL_DRIVER_VERSION>(), device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(),
+      embeddedSourcesHash(), plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
   if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
   if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
   sceneBuffers_ = std::move(sceneBuffers);
@@ -148,21 +149,29 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
     coefficients_ =
         cl::Buffer(device.context, CL_MEM_READ_ONLY, size_t(kern::coefficientsOffset(pixels, M)) * sizeof(float));
   share_.name = device.name();
-  // PoCL compiles a kernel for its work-group size at the first launch: pay that here,
-  // with a stage of no samples, not inside the first timed stage.
+  // PoCL compiles a kernel for its work-group size at the first launch, and its threads
+  // take their first work-groups: pay that here, with every pixel and no samples (a
+  // stage's own order would launch none), not inside the first timed stage.
   StagePlan empty;
   empty.techniqueCount = scene.techniqueCount();
   empty.counts.assign(size_t(scene.pixelCount()) * empty.techniqueCount, 0);
   empty.firstIndex.assign(empty.counts.size(), 0u);
-  run(empty, 0);
+  std::vector<int32_t> everyPixel(static_cast<size_t>(pixels));
+  std::iota(everyPixel.begin(), everyPixel.end(), 0);
+  runOrder(empty, 0, 0, {0, pixels}, everyPixel);
   if (keepsStatistics(config)) {
     empty.keepStatistics = false;
-    run(empty, 0);
+    runOrder(empty, 0, 0, {0, pixels}, everyPixel);
   }
   reset();
 }
 
 StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
+  return runOrder(plan, seed, firstSlot, range, coherentPixelOrder(plan, range));
+}
+
+StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range,
+                              const std::vector<int32_t>& order) {
   const int M = scene_.techniqueCount();
   StageResult result;
   if (range.size() == 0) return result;
@@ -172,8 +181,7 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
                            plan.counts.data() + firstRow);
   queue.enqueueWriteBuffer(firstIndex_, CL_FALSE, firstRow * sizeof(uint32_t), rows * sizeof(uint32_t),
                            plan.firstIndex.data() + firstRow);
-  const std::vector<int32_t> order = coherentPixelOrder(plan, range);
-  queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
+  if (!order.empty()) queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
   const bool statistics = plan.keepStatistics && keepsStatistics(config_);
   cl::Kernel& kernel = statistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
@@ -188,20 +196,31 @@ StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSl
   bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, b.productFloats, b.productWords, cl_int(scene_.tables.width),
        cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints, counts_, firstIndex_,
        cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
-       cl_int(range.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
+       cl_int(order.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
        cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
-  const size_t global = lanes > 0 ? size_t(range.size()) * lanes : (size_t(range.size()) + local - 1) / local * local;
-  cl::Event done;
-  queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &done);
-  done.wait();
-  result.kernelSeconds = eventSeconds(done);
+  const size_t global = lanes > 0 ? order.size() * lanes : (order.size() + local - 1) / local * local;
+  if (global > 0) {
+    cl::Event done;
+    queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &done);
+    done.wait();
+    result.kernelSeconds = eventSeconds(done);
+  }
   auto read = [&](const cl::Buffer& b, size_t first, size_t n) {
     return doubleSums_ ? readSums<double>(device_, b, first, n) : readSums<float>(device_, b, first, n);
   };
   result.rgb = read(rgb_, kern::estimateOffset(range.begin), kern::estimateOffset(range.size()));
   result.moments = read(moments_, kern::momentsOffset(range.begin, M), kern::momentsOffset(range.size(), M));
+  // The pixels left out of the launch took no samples: their sums are zero, whatever
+  // the buffers hold from earlier stages.
+  if (order.size() < size_t(range.size()))
+    for (int p = range.begin; p < range.end; ++p)
+      if (!takesSamples(plan, p)) {
+        const size_t i = size_t(p - range.begin);
+        std::fill_n(result.rgb.begin() + ptrdiff_t(kern::estimateOffset(int(i))), 3, 0.0);
+        std::fill_n(result.moments.begin() + ptrdiff_t(kern::momentsOffset(int(i), M)), 2 * M, 0.0);
+      }
   share_.pixelStages += range.size();
   share_.samples += (long long)range.size() * plan.stageSamples;
   share_.tiles += 1;

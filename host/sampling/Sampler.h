@@ -68,6 +68,10 @@ class Sampler : public StageSampler {
   void forgetStages() override;
 
  private:
+  // runPixels over the pixels of `order` (coherentPixelOrder); the other pixels of
+  // `range` take no samples.
+  StageResult runOrder(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range,
+                       const std::vector<int32_t>& order);
   // The plan's optimal-weight coefficients of `range` (zeros where it has none) into
   // coefficients_.
   void writeCoefficients(const StagePlan& plan, PixelRange range);

@@ -23,7 +23,7 @@ struct StagePlan {
   int techniqueCount = 0;
   int stageSamples = 0;              // N: the same for every pixel
   int samplesBefore = 0;             // samples each pixel took in earlier stages
-  std::vector<int32_t> counts;       // [pixel·M + k], Σ_k = N
+  std::vector<int32_t> counts;       // [pixel·M + k], Σ_k = N, or 0 where a pixel takes none (the background)
   std::vector<uint32_t> firstIndex;  // [pixel·M + k]
   // False for a stage that no allocation follows: it runs the kernel without running
   // sums or stored samples, as fast as a fixed split's. Only the last stage may.
