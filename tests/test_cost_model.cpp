@@ -16,6 +16,7 @@
 #include "render/CostCache.h"
 #include "render/Render.h"
 #include "sampling/CostModel.h"
+#include "sampling/HostSampler.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -31,6 +32,16 @@ StagePlan planOf(const std::vector<std::vector<int>>& counts, bool keepStatistic
   plan.firstIndex.assign(plan.counts.size(), 0u);
   return plan;
 }
+
+// The C++ reference, keeping every plan it is asked to run.
+struct PlanRecorder final : HostSampler {
+  using HostSampler::HostSampler;
+  std::vector<StagePlan> plans;
+  StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override {
+    plans.push_back(plan);
+    return HostSampler::runPixels(plan, seed, firstSlot, range);
+  }
+};
 
 LaunchWork work(std::vector<double> slots, bool keepsStatistics = false) { return {keepsStatistics, std::move(slots)}; }
 
@@ -65,6 +76,27 @@ TEST_CASE("a launch leaves out the pixels that take no samples", "[costmodel]") 
   CHECK(coherentPixelOrder(plan, {0, 4}) == std::vector<int32_t>{2, 0});
   CHECK(coherentPixelOrder(plan, {1, 2}).empty());
   CHECK(launchWork(plan, Estimator::MultiSample, 3).slots == std::vector<double>{3 * 3, 3 * 3});
+}
+
+// A calibration that also sampled the background fitted its fixed cost to pixels that
+// renders leave out of their launches: its launches take the covered pixels only.
+TEST_CASE("the calibration launches the pixels a render launches and not the background", "[costmodel]") {
+  Scene scene = smallScene("forest_slope", "seed000", 24, 16);
+  giveBackground(scene, 5);
+  PlanRecorder sampler(scene);
+  calibrateCostModel(sampler);
+  REQUIRE(sampler.plans.size() > 1);
+  size_t background = 0, coveredLeftOut = 0;
+  for (const StagePlan& plan : sampler.plans)
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      const bool takes = takesSamples(plan, p);
+      if (scene.geometry.covered[size_t(p)])
+        coveredLeftOut += !takes;
+      else
+        background += takes;
+    }
+  CHECK(background == 0);
+  CHECK(coveredLeftOut == 0);
 }
 
 TEST_CASE("one pixel per work-group runs each count rounded up to the lanes", "[costmodel]") {

@@ -112,11 +112,4 @@ StagePlan singleStagePlan(const Scene& scene, Method method, int spp) {
   return plan;
 }
 
-void leaveOutBackground(const Scene& scene, std::vector<int32_t>& counts) {
-  const int M = scene.techniqueCount();
-  const std::vector<unsigned char>& covered = scene.geometry.covered;
-  for (size_t p = 0; p < covered.size(); ++p)
-    if (!covered[p]) std::fill_n(counts.begin() + ptrdiff_t(p * M), M, 0);
-}
-
 }  // namespace misalloc

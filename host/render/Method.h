@@ -65,8 +65,4 @@ std::vector<int> methodCounts(const Scene& scene, Method method, int spp, int pi
 // One stage of `spp` samples per pixel with a fixed split's counts.
 StagePlan singleStagePlan(const Scene& scene, Method method, int spp);
 
-// Counts [pixel·M + k] with the background's set to 0 (SceneGeometry::covered): it takes
-// no samples, whatever a method or an allocation would give it.
-void leaveOutBackground(const Scene& scene, std::vector<int32_t>& counts);
-
 }  // namespace misalloc

@@ -124,13 +124,16 @@ StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bo
   plan.techniqueCount = scene.techniqueCount();
   plan.keepStatistics = keepStatistics;
   for (int n : counts) plan.stageSamples += n;
+  // The pixels a render's stages launch: a calibration that also sampled the background
+  // fitted its fixed cost to pixels that renders leave out (LaunchWork.h).
   plan.counts = sameCountsEverywhere(scene.pixelCount(), counts);
+  leaveOutBackground(scene, plan.counts);
   plan.firstIndex.assign(plan.counts.size(), 0u);
   return plan;
 }
 
-// Samples per technique that make a launch of every pixel last about 10 ms, from one
-// launch of one sample per technique.
+// Samples per technique that make a launch of the covered pixels last about 10 ms, from
+// one launch of one sample per technique.
 int calibrationSize(StageSampler& sampler, int capacity) {
   const Scene& scene = sampler.scene();
   StagePlan probe = calibrationPlan(scene, std::vector<int>(scene.techniqueCount(), 1), false);

@@ -121,11 +121,10 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       cl::Kernel(buildProgram(device, "sample.cl", plainOptions), pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
   kernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl", statisticsOptions), "sampleStage")
                                     : plainKernel_;
-  launchIdentity_ = fmt::format(
-      "{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}; "
-      "launches the pixels that take samples",
-      device.name(), device.device.getInfo<CL_DRIVER_VERSION>(), device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(),
-      embeddedSourcesHash(), plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
+  launchIdentity_ = fmt::format("{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}", device.name(),
+                                device.device.getInfo<CL_DRIVER_VERSION>(),
+                                device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), embeddedSourcesHash(),
+                                plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
   if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
   if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
   sceneBuffers_ = std::move(sceneBuffers);

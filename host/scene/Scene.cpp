@@ -107,6 +107,13 @@ const Vec3f& flatMirror(const SceneGeometry& geometry, const std::string& option
   return geometry.pixels.front().mirror;
 }
 
+void leaveOutBackground(const Scene& scene, std::vector<int32_t>& counts) {
+  const int M = scene.techniqueCount();
+  const std::vector<unsigned char>& covered = scene.geometry.covered;
+  for (size_t p = 0; p < covered.size(); ++p)
+    if (!covered[p]) std::fill_n(counts.begin() + ptrdiff_t(p * M), M, 0);
+}
+
 Scene makeScene(const SceneOptions& options) {
   if (options.product && options.splitBrdf)
     throw InputError(

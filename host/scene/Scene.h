@@ -78,6 +78,10 @@ struct Scene {
 // product tables are built; throws InputError naming `option` for any other geometry.
 const Vec3f& flatMirror(const SceneGeometry& geometry, const std::string& option);
 
+// Counts [pixel·M + k] with the background's set to 0 (SceneGeometry::covered): it takes
+// no samples, whatever a method, an allocation or a calibration would give it.
+void leaveOutBackground(const Scene& scene, std::vector<int32_t>& counts);
+
 // Builds the scene, reading the optimal pdf's tables from SceneOptions::bankCacheDir
 // where they are cached there.
 Scene makeScene(const SceneOptions& options);
