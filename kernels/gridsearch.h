@@ -419,7 +419,10 @@ MA_FN float pooledVarianceRatio(float best, float bestCost, float equal, float e
 // significant: Σ d_q more than MA_SKIP_Z standard errors above 0, the d_q taken as
 // independent draws (a one-sided t-test; a single pixel cannot be tested). Adapting is
 // skipped otherwise, also for NaN and where equal weights already have no variance.
-#define MA_SKIP_Z 3.0f
+// One standard error: a wrong adaptation where V(α) is flat costs little, and a pilot
+// of a few samples per pixel rarely shows a real gain at 2 or 3 (docs/results.md,
+// "The skip rule's significance").
+#define MA_SKIP_Z 1.0f
 MA_FN int skipsAdapting(float best, float equal, float minGain, float sumD, float sumD2, float count) {
   if (!(best > (1.0f - minGain) * equal)) return 1;
   if (count < 2.0f) return 0;

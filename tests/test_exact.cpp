@@ -544,12 +544,18 @@ TEST_CASE("with share columns each combination is judged by its own share's pdf"
   BothResults skewedShares = searchBoth(asShareColumns(pixels, shares, drawn, skewed), columns, costs,
                                         GridRule::MinCostVariance, kDefaultGridSize, 0, pooling);
   checkSameSelection(skewedShares.device, skewedShares.reference);
-  double before = 0, after = 0;
-  for (int p = 0; p < width * height; ++p) {
-    before += techniques.reference.allocations[p].alpha[0];
-    after += skewedShares.reference.allocations[p].alpha[0];
-  }
-  CHECK(after < before);
+  // So more pixels choose an α_0 that samples with the share of small α_0, and none
+  // more one that samples with the share of large α_0.
+  auto pixelsInShares = [&](const GridSearchResult& r, bool below) {
+    int n = 0;
+    for (const Allocation& a : r.allocations) {
+      const int share = kern::bankShareOf(shares, float(a.alpha[0]));
+      n += below ? share < drawn : share > drawn;
+    }
+    return n;
+  };
+  CHECK(pixelsInShares(skewedShares.reference, true) > pixelsInShares(techniques.reference, true));
+  CHECK(pixelsInShares(skewedShares.reference, false) <= pixelsInShares(techniques.reference, false));
   // Rule (a) ranks each column by its own samples, which a share not drawn has none of.
   StoredSampleLayout layout = layoutOf(pixels, columns, 60);
   std::vector<float> samples = store(asShareColumns(pixels, shares, drawn, same), layout);
