@@ -4,6 +4,7 @@
 // the maths that the OpenCL kernels run.
 #include <Random123/philox.h>
 
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +14,7 @@
 namespace misalloc::kern {
 #include "estimator.h"
 #include "fallbacks.h"
+#include "gridsearch.h"
 #include "pixel.h"
 #include "pixel_layout.h"
 #include "stats.h"

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
-#include <cfloat>
 #include <cmath>
 #include <cstring>
 
@@ -16,10 +15,6 @@
 #include "TestDevice.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
-
-namespace misalloc::kern {
-#include "gridsearch.h"
-}  // namespace misalloc::kern
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -150,8 +145,8 @@ TEST_CASE("the skip rule keeps equal counts where adapting cannot pay, and only 
   // A cos θ sky over a diffuse surface: the envmap pdf and BRDF sampling are both
   // cos θ/π (up to the texels), so V(α) is flat and no α gains anything.
   // Pure noise adapts where the best of the grid's noisy scores beats equal counts by
-  // --skip-below and MA_SKIP_Z standard errors of the window's differences. That is a
-  // t-test at P(T > 1) ≈ 17 % for one combination; the search picks the best of 80 on
+  // --skip-below and MA_SKIP_Z standard errors of the window's differences. At one
+  // standard error that is a t-test at P(T > 1) ≈ 17 % for one combination; the search picks the best of 80 on
   // the same samples, so more windows pass: 33 % of the pixels here over 8 seeds (46 %
   // without the significance test, none at three standard errors). The rule's purpose
   // is the gain it lets through where there is one (docs/results.md, "The skip rule's

@@ -3,16 +3,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cfloat>
 #include <chrono>
 #include <stdexcept>
 
 #include "Constants.h"
 #include "KernelCode.h"
 #include "cl/KernelArgs.h"
-namespace misalloc::kern {
-#include "gridsearch.h"
-}  // namespace misalloc::kern
 
 namespace misalloc {
 
