@@ -333,14 +333,18 @@ __kernel void gridSearch(__global const float* samples, int capacity, int taken,
 // poolWindow), and the skip rule; one work-item per pixel. Reads gridSearch's outputs:
 // the scores, scales, and its α, l₀ and fallbacks (alpha, selected, fallbacks), which a
 // pixel with no ranked pixel in its window keeps. Writes α, l₀ (−1 where the pixel fell
-// back or skipped), the fallback and skip flags, and V(equal)/V(selected) as the window
-// predicts it (pooledVarianceRatio; 1 where the pixel skipped or kept its own α).
+// back or skipped), the fallback and skip flags, V(equal)/V(selected) as the window
+// predicts it (pooledVarianceRatio; 1 where the pixel skipped or kept its own α), and
+// the pixel's held-out variances at equal weights and at the weights it will run
+// (heldOutVariance; NaN where the window did not leave it out or it kept its own α,
+// 0 where its own samples could not be searched).
 __kernel void selectPooled(__global const float* scores, __global const float* scales, __global const float* alpha,
                            __global const int* selected, __global const uint* fallbacks, __global const int* surfaces,
                            int width, int height, int radius, __global const float* gridLanes,
                            __global const float* gridCost, int gridSize, int paddedSize, int equal, float minGain,
                            __global float* alphaOut, __global int* selectedOut, __global uint* fallbacksOut,
-                           __global uchar* skippedOut, __global float* varianceRatioOut) {
+                           __global uchar* skippedOut, __global float* varianceRatioOut,
+                           __global float* heldOutOut) {
   int pixel = (int)get_global_id(0);
   if (pixel >= width * height) return;
   PoolWindow w = poolWindow(pixel, width, height, radius, surfaces[pixel]);
@@ -404,4 +408,14 @@ __kernel void selectPooled(__global const float* scores, __global const float* s
   fallbacksOut[pixel] = best < 0 ? fallbacks[pixel] : 0u;
   skippedOut[pixel] = (uchar)skipped;
   varianceRatioOut[pixel] = ratio;
+  float heldOutEqual = NAN, heldOutRun = NAN;
+  if (best >= 0 && w.self >= 0) {
+    __global const float* own = scores + (size_t)pixel * paddedSize;
+    const int run = skipped ? equal : best;
+    const int searched = fallbacks[pixel] == 0u;
+    heldOutEqual = searched ? heldOutVariance(own[equal], gridCost[equal], scales[pixel]) : 0.0f;
+    heldOutRun = searched ? heldOutVariance(own[run], gridCost[run], scales[pixel]) : 0.0f;
+  }
+  heldOutOut[2 * pixel] = heldOutEqual;
+  heldOutOut[2 * pixel + 1] = heldOutRun;
 }

@@ -411,6 +411,14 @@ MA_FN float pooledVarianceRatio(float best, float bestCost, float equal, float e
   return varianceBest > 0.0f ? varianceEqual / varianceBest : INFINITY;
 }
 
+// The pixel's own variance (not cost × variance) at a combination, from its own score
+// (≤ 0, in the units of its scale: sampleScale), the combination's cost per sample and
+// that scale. Where the window left the pixel out, its own samples did not choose the
+// combination, so this is a held-out check of the choice: summed over the image, it
+// predicts what the allocation gains without the optimism of a selection judged by
+// the samples that made it (host/alloc/WholeImageRule.h).
+MA_FN float heldOutVariance(float score, float cost, float scale) { return -score / cost / scale / scale; }
+
 // The skip rule, from the pooled scores of the best and the equal combination and the
 // sum and sum of squares of the window's `count` per-pixel differences d_q (their
 // pooled score at best minus at equal). Scores are −cost × variance ≤ 0, so the

@@ -21,9 +21,12 @@ using namespace misalloc::test;
 
 namespace {
 
-Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed) {
+Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed,
+                     double imageGainBelow = kDefaultImageGainBelow, int stages = 1) {
   AdaptiveOptions options;
   options.costs.assign(scene.techniqueCount(), 1.0);
+  options.imageGainBelow = imageGainBelow;
+  options.stages = stages;
   options.oracleSamples = 128;
   const auto sampler = sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
   return render(*sampler, method, options, spp, seed);
@@ -152,10 +155,11 @@ TEST_CASE("the skip rule keeps equal counts where adapting cannot pay, and only 
   // is the gain it lets through where there is one (docs/results.md, "The skip rule's
   // significance"); here, where no α gains anything, most pixels still keep equal
   // counts, and every pixel that skips splits every stage equally.
+  // The whole-image rule is off: it would keep equal counts for all of this image.
   Scene flat = smallScene("cosk:1", "uniform:1,0,1", 24, 16);
   size_t adapted = 0;
   for (uint64_t seed = 1; seed <= 8; ++seed) {
-    Rendering r = renderWith(flat, Method::Exact, 100, seed);
+    Rendering r = renderWith(flat, Method::Exact, 100, seed, 0.0);
     adapted += flat.pixelCount() - r.skippedPixels;
     // Equal counts in every stage: the odd pilot of 5 and stage of 95 give technique 0
     // one sample more in each.
@@ -196,4 +200,53 @@ TEST_CASE("the pilot weighs less where the neighbours predict that alpha beats e
   Rendering skipped = renderWith(flat, Method::Exact, 100, 9);
   CHECK(skipped.meanPilotWeight ==
         Approx(0.05).margin(0.05 * double(flat.pixelCount() - skipped.skippedPixels) / flat.pixelCount()));
+}
+
+TEST_CASE("exact keeps equal counts for the whole image where its held-out pilot predicts no gain", "[adaptive][image]") {
+  // The flat case of the skip rule: no α gains much, but a third of the pixels adapt to
+  // noise (above). The pixels' own samples, which did not choose their α, predict the
+  // image's gain without that selection's optimism: 1.006 in geometric mean over 8
+  // seeds (0.996–1.016 each), against 1.017 (1.009–1.026) where the prediction takes the
+  // ratio V(equal)/V(α) that the neighbours who chose α predict (a bug planted once in
+  // the kernel's and the reference's held-out variance). At equal costs the predicted
+  // gain is the variances' ratio alone.
+  Scene flat = smallScene("cosk:1", "uniform:1,0,1", 24, 16);
+  double heldOut = 0;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    Rendering adapting = renderWith(flat, Method::Exact, 100, seed, 0.0);
+    REQUIRE(adapting.predictedGain);
+    CHECK_FALSE(adapting.keptEqualCounts);
+    heldOut += std::log(*adapting.predictedGain) / 8;
+  }
+  INFO(fmt::format("held-out gain {:.4f}, geometric mean over 8 seeds", std::exp(heldOut)));
+  CHECK(std::exp(heldOut) < 1.012);
+  // Below the rule's threshold the whole image keeps equal counts, and says so: every
+  // pixel splits the stage after the pilot equally, in one stage whatever --stages says,
+  // and the pilot keeps its share.
+  for (int stages : {1, 3}) {
+    Rendering kept = renderWith(flat, Method::Exact, 100, 3, 1.5, stages);
+    REQUIRE(kept.predictedGain);
+    CHECK(*kept.predictedGain < 1.5);
+    CHECK(kept.keptEqualCounts);
+    CHECK(kept.stageCount == 2);
+    CHECK(kept.skippedPixels == size_t(flat.pixelCount()));
+    CHECK(kept.meanPilotWeight == Approx(0.05).epsilon(1e-12));
+    for (int p = 0; p < flat.pixelCount(); ++p) CHECK(kept.alpha[size_t(p) * 2] == 0.51);
+  }
+  // Where α pays (BRDF sampling alone has no variance under a constant sky) the rule
+  // predicts the gain and lets the allocation run.
+  Scene constant = smallScene("constant", "uniform:1,0,1", 24, 16);
+  Rendering adapted = renderWith(constant, Method::Exact, 100, 9);
+  REQUIRE(adapted.predictedGain);
+  CHECK(*adapted.predictedGain > 2.0);
+  CHECK_FALSE(adapted.keptEqualCounts);
+  // Without neighbours (--pool 0) a pixel's own samples chose its α: nothing is held out,
+  // nothing is predicted, and the rule cannot apply.
+  AdaptiveOptions own;
+  own.costs = {1.0, 1.0};
+  own.poolRadius = 0;
+  Sampler sampler(testDevice(), flat, samplerConfigFor(Method::Exact, Estimator::MultiSample, 100, own));
+  Rendering unpredicted = render(sampler, Method::Exact, own, 100, 3);
+  CHECK_FALSE(unpredicted.predictedGain);
+  CHECK_FALSE(unpredicted.keptEqualCounts);
 }

@@ -76,6 +76,33 @@ cl::Buffer deviceBuffer(std::vector<float>& samples) {
                     samples.data());
 }
 
+// Equal floats, NaN where the other is NaN.
+bool sameFloats(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) {
+           return x == y || (std::isnan(x) && std::isnan(y));
+         });
+}
+
+// V(α) of the multi-sample balance heuristic for N = 1 as a pixel's samples estimate it
+// ([SHS16] eq. 21, kernels/gridsearch.h costVarianceScore): samples drawn at equal counts
+// of the techniques, so from q = Σ_k p_k / M; g = f/p_α, w = f/q, r_j = p_j/q, and
+// V = mean(g w) − Σ_j α_j mean(g r_j)².
+double balanceVariance(const PixelSampleList& samples, const std::vector<double>& alpha) {
+  const size_t m = alpha.size();
+  double s2 = 0;
+  std::vector<double> mu(m, 0.0);
+  for (const Sample& s : samples) {
+    double pAlpha = 0, q = 0;
+    for (size_t k = 0; k < m; ++k) pAlpha += alpha[k] * s.pdf[k], q += s.pdf[k] / m;
+    const double g = s.f / pAlpha;
+    s2 += g * s.f / q / samples.size();
+    for (size_t j = 0; j < m; ++j) mu[j] += g * s.pdf[j] / q / samples.size();
+  }
+  double v = s2;
+  for (size_t j = 0; j < m; ++j) v -= alpha[j] * mu[j] * mu[j];
+  return v;
+}
+
 struct BothResults {
   GridSearchResult device, reference;
 };
@@ -471,6 +498,7 @@ TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not it
     CHECK(r->device.selected == r->reference.selected);
     CHECK(r->device.skipped == r->reference.skipped);
     CHECK(r->device.varianceRatio == r->reference.varianceRatio);
+    CHECK(sameFloats(r->device.heldOutVariance, r->reference.heldOutVariance));
   }
   const int adapted = int(std::count(before.reference.skipped.begin(), before.reference.skipped.end(), 0));
   INFO(fmt::format("{} of {} pixels adapt", adapted, width * height));
@@ -489,11 +517,28 @@ TEST_CASE("a pixel's pooled selection comes from its neighbours' samples, not it
     for (int x = 5; x <= 9; ++x)
       moved += after.reference.varianceRatio[y * width + x] != before.reference.varianceRatio[y * width + x];
   CHECK(moved >= 20);
-  // Radius 0: every pixel by its own samples, and no ratio to weigh a pilot by.
+  // The held-out variances are the pixel's own: they follow its samples, and they are
+  // the variance of the multi-sample estimator at the weights its neighbours chose, as
+  // the pixel's samples estimate it (kernels/gridsearch.h, costVarianceScore), computed
+  // here in double from the samples themselves.
+  CHECK(after.reference.heldOutVariance[2 * self + 1] != before.reference.heldOutVariance[2 * self + 1]);
+  for (const auto* r : {&before, &after}) {
+    const PixelSampleList& own = (r == &before ? pixels : changed)[self];
+    const std::vector<double>& alpha = r->reference.allocations[self].alpha;
+    CHECK(r->reference.heldOutVariance[2 * self + 1] == Approx(balanceVariance(own, alpha)).epsilon(1e-4));
+  }
+  for (int p = 0; p < width * height; ++p) {
+    CHECK(before.reference.heldOutVariance[2 * p] > 0.0f);
+    CHECK(before.reference.heldOutVariance[2 * p + 1] > 0.0f);
+  }
+  // Radius 0: every pixel by its own samples, and no ratio to weigh a pilot by, and
+  // nothing held out.
   BothResults own = searchBoth(pixels, m, costs, GridRule::MinCostVariance, kDefaultGridSize, 0,
                                PooledSelection{width, height, 0, 0.02});
   CHECK(
       std::all_of(own.device.varianceRatio.begin(), own.device.varianceRatio.end(), [](float r) { return r == 1.0f; }));
+  for (const GridSearchResult* r : {&own.device, &own.reference})
+    CHECK(std::all_of(r->heldOutVariance.begin(), r->heldOutVariance.end(), [](float v) { return std::isnan(v); }));
 }
 
 // Samples of two techniques as share columns (kernels/stats.h): envmap samples drawn

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include "Constants.h"
@@ -157,6 +158,7 @@ struct SelectionArrays {
   std::vector<unsigned> fallbacks;
   std::vector<unsigned char> skipped;
   std::vector<float> varianceRatio;
+  std::vector<float> heldOutVariance;  // [2·pixel + {0: equal weights, 1: the weights run}]
 };
 
 // The allocations per technique: a technique's weight is the sum of its columns'; a
@@ -168,6 +170,7 @@ GridSearchResult toResult(const SelectionArrays& a, SampleColumns columns) {
   result.selected = a.selected;
   result.skipped = a.skipped;
   result.varianceRatio = a.varianceRatio;
+  result.heldOutVariance = a.heldOutVariance;
   result.allocations.reserve(pixels);
   for (std::size_t p = 0; p < pixels; ++p) {
     std::vector<double> alpha(m, 0.0);
@@ -438,12 +441,22 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
   out.fallbacks[pixel] = best < 0 ? in.fallbacks[pixel] : 0u;
   out.skipped[pixel] = (unsigned char)skipped;
   out.varianceRatio[pixel] = ratio;
+  float heldOutEqual = NAN, heldOutRun = NAN;
+  if (best >= 0 && w.self >= 0) {
+    const float* own = scores.data() + std::size_t(pixel) * padded;
+    const int run = skipped ? equal : best;
+    const bool searched = in.fallbacks[pixel] == 0u;
+    heldOutEqual = searched ? kern::heldOutVariance(own[equal], setup.lanes.cost[equal], scales[pixel]) : 0.0f;
+    heldOutRun = searched ? kern::heldOutVariance(own[run], setup.lanes.cost[run], scales[pixel]) : 0.0f;
+  }
+  out.heldOutVariance[2 * std::size_t(pixel)] = heldOutEqual;
+  out.heldOutVariance[2 * std::size_t(pixel) + 1] = heldOutRun;
 }
 
 SelectionArrays selectionArrays(int pixels, int m) {
   return SelectionArrays{std::vector<float>(std::size_t(pixels) * m), std::vector<int>(pixels),
                          std::vector<unsigned>(pixels), std::vector<unsigned char>(pixels, 0),
-                         std::vector<float>(pixels, 1.0f)};
+                         std::vector<float>(pixels, 1.0f), std::vector<float>(2 * std::size_t(pixels), NAN)};
 }
 
 }  // namespace
@@ -593,10 +606,11 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     fallbacksFinal = cl::Buffer(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));
     cl::Buffer skippedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels));
     cl::Buffer ratioOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(float));
+    cl::Buffer heldOut(device_.context, CL_MEM_WRITE_ONLY, 2 * std::size_t(pixels) * sizeof(float));
     bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, surfaces_,
                    cl_int(pooling->width), cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost,
                    cl_int(grid.size()), cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)),
-                   cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut);
+                   cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut, heldOut);
     cl::Event pooled;
     device_.queue.enqueueNDRangeKernel(
         poolKernel_, cl::NullRange,
@@ -606,6 +620,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     result.seconds += eventSeconds(pooled);
     device_.queue.enqueueReadBuffer(skippedOut, CL_FALSE, 0, pixels, out.skipped.data());
     device_.queue.enqueueReadBuffer(ratioOut, CL_FALSE, 0, pixels * sizeof(float), out.varianceRatio.data());
+    device_.queue.enqueueReadBuffer(heldOut, CL_FALSE, 0, 2 * pixels * sizeof(float), out.heldOutVariance.data());
   }
   device_.queue.enqueueReadBuffer(alphaFinal, CL_FALSE, 0, out.alpha.size() * sizeof(float), out.alpha.data());
   device_.queue.enqueueReadBuffer(selectedFinal, CL_FALSE, 0, pixels * sizeof(cl_int), out.selected.data());

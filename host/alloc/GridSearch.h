@@ -89,6 +89,11 @@ struct GridSearchResult {
   // predict it, α the selected weights: 1 where the selection did not come from the
   // neighbours alone (no pooling, radius 0, no ranked neighbour) or skipped.
   std::vector<float> varianceRatio;
+  // Per pixel at [2·pixel + {0, 1}], the variance of equal weights and of the weights it
+  // runs, by its own samples, which did not choose them (kernels/gridsearch.h,
+  // heldOutVariance): NaN where its selection did not come from the neighbours alone,
+  // 0 where its own samples could not be searched. Only a pooled selection writes them.
+  std::vector<float> heldOutVariance;
   double seconds = 0;  // kernel time (profiling event), or the reference's wall time
 
   int fallbackCount() const;

@@ -68,7 +68,8 @@ GridSearchAllocator::GridSearchAllocator(StageStatistics& stages, GridRule rule,
 
 StageAllocation GridSearchAllocator::allocate(StageStatistics& stages, const std::vector<double>& costs) {
   GridSearchResult search = keptSearch(stages).run(stages.takeStoredSamples(), costs, rule_, pooling_);
-  return {std::move(search.allocations), std::move(search.varianceRatio), std::move(search.skipped)};
+  return {std::move(search.allocations), std::move(search.varianceRatio), std::move(search.skipped),
+          std::move(search.heldOutVariance)};
 }
 
 }  // namespace misalloc

@@ -19,6 +19,9 @@ struct StageAllocation {
   // weighs the pilot (StageWeights.h, pilotWeight).
   std::vector<float> varianceRatio;
   std::vector<unsigned char> skipped;  // per pixel: 1 where the skip rule kept equal weights
+  // exact: per pixel, the variance of equal weights and of α by its held-out samples
+  // (GridSearchResult::heldOutVariance); empty for the other allocations.
+  std::vector<float> heldOutVariance;
 };
 
 class StageAllocator {

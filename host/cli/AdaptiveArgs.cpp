@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <climits>
+#include <cmath>
 
 #include "Error.h"
 #include "OptionRange.h"
@@ -43,6 +44,12 @@ void AdaptiveArgs::add(CLI::App& command) {
                   "exact: keep equal counts where the predicted gain of adapting is below this fraction")
       ->capture_default_str()
       ->check(realIn(0, 1, false, true));
+  command
+      .add_option("--skip-image-below", options.imageGainBelow,
+                  "exact: keep equal counts for the whole image where the pilot predicts a gain at equal time below "
+                  "this (0: never)")
+      ->capture_default_str()
+      ->check(realIn(0, INFINITY, false, true));
   command
       .add_option("--cost", costList,
                   "adaptive methods: cached (the calibration cached for this device, kernel build and scene, made "

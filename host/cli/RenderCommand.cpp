@@ -119,6 +119,11 @@ int runRender(RenderCommandArgs& args) {
   std::cout << fmt::format("{} | {} x {} | {}x{} | {} spp | {} | {:.3f} s (kernel {:.3f} s, allocation {:.3f} s)\n",
                            outcome.deviceName, scene.options.envmap, scene.options.grid, scene.grid.width,
                            scene.grid.height, ra.spp, traits.name, r.wallSeconds, r.kernelSeconds, r.allocationSeconds);
+  if (r.keptEqualCounts)
+    std::cout << fmt::format(
+        "kept equal counts after the pilot: it predicted a gain of {:.3f} over them at equal time, below "
+        "--skip-image-below {:g}\n",
+        *r.predictedGain, plan.adaptive.imageGainBelow);
   if (reference)
     std::cout << fmt::format(
         "RMSE x1000 {:.3f}, {:.3f} corrected for the reference's own error, relative MSE {:.4g} (reference: {})\n",

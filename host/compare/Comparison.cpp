@@ -60,6 +60,8 @@ RunRecord recordRun(const CaseInfo& info, Method method, int budget, int repeat,
   rec.skippedFraction = s.skippedFraction;
   rec.weightsFallbackFraction = s.weightsFallbackFraction;
   rec.statisticsBytesPerPixel = r.statisticsBytesPerPixel;
+  rec.predictedGain = r.predictedGain;
+  rec.keptEqualCounts = r.keptEqualCounts;
   rec.stages = r.stages;
   if (r.costModel) rec.costSource = costSourceName(r.costModel->source());
   return rec;
@@ -86,6 +88,8 @@ nlohmann::json runJson(const RunRecord& r) {
           {"weights_fallback_pixel_fraction", r.weightsFallbackFraction},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
           {"costs_source", r.costSource},
+          {"predicted_gain", r.predictedGain ? nlohmann::json(*r.predictedGain) : nlohmann::json()},
+          {"kept_equal_counts", r.keptEqualCounts},
           {"stages", stagesJson(r.stages)}};
 }
 
@@ -100,15 +104,16 @@ std::string runsCsv(const Comparison& comparison) {
       "case,method,spp,repeat,seed,wall_s,kernel_s,allocation_s,host_s,rmse_x1000,mse_corrected,"
       "mse_corrected_standard_error,relative_mse,efficiency,"
       "mean_alpha_envmap,fallback_pixel_fraction,floored_pixel_fraction,skipped_pixel_fraction,"
-      "weights_fallback_pixel_fraction,statistics_bytes_per_pixel\n";
+      "weights_fallback_pixel_fraction,statistics_bytes_per_pixel,predicted_gain,kept_equal_counts\n";
   for (const RunRecord& r : comparison.runs)
     csv += fmt::format(
         "{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
-        "{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n",
+        "{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{}\n",
         r.caseLabel, methodName(r.method), r.budget, r.repeat, r.seed, r.wallSeconds, r.kernelSeconds,
         r.allocationSeconds, r.hostSeconds, 1000 * std::sqrt(r.rawMse), r.mse, r.mseStandardError, r.relativeMse,
         r.efficiency(), r.meanAlpha.front(), r.fallbackFraction, r.flooredFraction, r.skippedFraction,
-        r.weightsFallbackFraction, r.statisticsBytesPerPixel);
+        r.weightsFallbackFraction, r.statisticsBytesPerPixel,
+        r.predictedGain ? fmt::format("{:.6g}", *r.predictedGain) : std::string(), r.keptEqualCounts ? 1 : 0);
   return csv;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,8 @@ struct RunRecord {
   double skippedFraction = 0;          // pixels the skip rule kept at equal weights
   double weightsFallbackFraction = 0;  // optimal weights: pixels a stage left at the balance heuristic
   double statisticsBytesPerPixel = 0;
+  std::optional<double> predictedGain;  // exact: the pilot's whole-image prediction (Rendering)
+  bool keptEqualCounts = false;         // exact: the whole-image rule kept equal counts
   std::vector<StageTiming> stages;  // kernel times, predicted and measured
   std::string costSource;           // adaptive methods: their cost model's (costSourceName)
 

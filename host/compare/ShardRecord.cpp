@@ -27,6 +27,8 @@ nlohmann::json runRecordJson(const RunRecord& r) {
           {"fractions", {r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.weightsFallbackFraction}},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
           {"costs_source", r.costSource},
+          {"predicted_gain", r.predictedGain ? nlohmann::json(*r.predictedGain) : nlohmann::json()},
+          {"kept_equal_counts", r.keptEqualCounts},
           {"stages", stagesJson(r.stages)}};
 }
 
@@ -48,6 +50,9 @@ RunRecord runRecordOf(const nlohmann::json& j) {
   r.weightsFallbackFraction = f.at(3);
   r.statisticsBytesPerPixel = j.at("statistics_bytes_per_pixel");
   r.costSource = j.at("costs_source");
+  if (j.contains("predicted_gain") && !j.at("predicted_gain").is_null())
+    r.predictedGain = j.at("predicted_gain").get<double>();
+  r.keptEqualCounts = j.value("kept_equal_counts", false);
   for (const auto& s : j.at("stages")) {
     StageTiming t;
     t.samples = s.at("samples");

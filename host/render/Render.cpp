@@ -17,6 +17,7 @@
 #include "alloc/GridSearchAllocator.h"
 #include "alloc/PixelRuleAllocator.h"
 #include "alloc/StageWeights.h"
+#include "alloc/WholeImageRule.h"
 #include "render/RunChecks.h"
 
 namespace misalloc {
@@ -307,10 +308,21 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     StagePlan last = pilot.plan;  // the last stage, whose samples a grid search stored
     std::vector<double> pilotWeights;
     for (size_t b = 1; b < sizes.size(); ++b) {
-      const bool keepStatistics = b + 1 < sizes.size();
+      bool keepStatistics = b + 1 < sizes.size();
       auto allocationStart = Clock::now();
       // Each technique weighed by its cost in the kernel that runs the next stage.
       StageAllocation next = allocator->allocate(sampler, model->perSample(keepStatistics));
+      if (b == 1) {
+        out.predictedGain = predictedImageGain(next, model->perSample(false), scene.geometry.covered);
+        if (keepsEqualCounts(out.predictedGain, options.imageGainBelow)) {
+          // The rest of the budget in one stage at equal counts, which no allocation follows.
+          out.keptEqualCounts = true;
+          next = equalStageAllocation(pixels, M);
+          sizes = {sizes[0], spp - sizes[0]};
+          out.stageCount = 2;
+          keepStatistics = false;
+        }
+      }
       for (int p = 0; p < pixels; ++p) progress.skipped[p] &= next.skipped[p];
       std::vector<int32_t> counts = stageCounts(progress, next.allocations, sizes[b]);
       std::vector<float> coefficients =

@@ -22,6 +22,12 @@ inline constexpr int kDefaultRisCandidates = 2;
 // time per candidate of 16 (docs/results.md).
 inline constexpr int kMaxRisCandidates = 16;
 
+// exact's whole-image rule keeps equal counts where its predicted gain is below this
+// (--skip-image-below): where the pilot predicts that the allocation loses at equal
+// time. A margin above 1 gave up more real gains than it saved losses (docs/results.md,
+// "The whole-image rule").
+inline constexpr double kDefaultImageGainBelow = 1.0;
+
 // The batched schedule of the adaptive methods ([HS14] Algorithm 1, Sec. 5.2), and the
 // options of the other methods that take any (oracle, ris).
 struct AdaptiveOptions {
@@ -29,6 +35,8 @@ struct AdaptiveOptions {
   int stages = 1;               // after the pilot
   int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
   double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
+  // exact: the whole-image rule's least predicted gain at equal time (alloc/WholeImageRule.h)
+  double imageGainBelow = kDefaultImageGainBelow;
   std::vector<double> costs;    // c_k per sample, one per technique (--cost); empty: the sampler's CostModel
   bool measureCosts = false;    // --cost measure: the caller calibrates the samplers again (render/CostCache.h)
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
@@ -62,6 +70,11 @@ struct Rendering {
   size_t skippedPixels = 0;                  // pixels that the skip rule kept at equal weights in every stage
   OptimalWeightsFallbacks weightsFallbacks;  // --weights optimal: pixels a stage left at the balance heuristic
   int stageCount = 1;
+  // exact: the image's efficiency gain over equal counts that the pilot predicts for
+  // the stages after it (alloc/WholeImageRule.h), and whether the render then kept
+  // equal counts for all of them
+  std::optional<double> predictedGain;
+  bool keptEqualCounts = false;
   double meanPilotWeight = 0;          // staged methods: the pilot's weight in the estimate, mean over pixels
   double statisticsBytesPerPixel = 0;  // running sums and stored samples kept for the allocation
   double kernelSeconds = 0;            // device time of the sampling kernels (profiling events)

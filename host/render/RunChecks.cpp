@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include <algorithm>
 
 #include "Error.h"
@@ -182,6 +184,9 @@ void requireValidRun(const SceneOptions& scene, Method method, Estimator estimat
       throw InputError(fmt::format("--pool {}: the radius must be at least 0", options.poolRadius));
     if (!(options.minGain >= 0 && options.minGain < 1))
       throw InputError(fmt::format("--skip-below {}: the gain must lie in [0, 1)", options.minGain));
+    if (!(options.imageGainBelow >= 0 && std::isfinite(options.imageGainBelow)))
+      throw InputError(
+          fmt::format("--skip-image-below {}: the gain must be finite and at least 0", options.imageGainBelow));
     if (traits.searchesWeights && options.gridRule == GridRule::MaxEntropy && options.poolRadius > 0)
       throw InputError("--grid-rule entropy ranks every pixel by itself: give --pool 0");
   }

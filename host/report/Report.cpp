@@ -216,6 +216,11 @@ nlohmann::json renderReport(const RenderRun& run) {
               ? "maximum entropy of normalised lambda ([HS14] Alg. 1 line 13)"
               : "minimum cost x multi-sample variance ([SHS16] eq. 21)";
     }
+    if (run.method == Method::Exact) {
+      report["allocation"]["skip_image_below"] = run.adaptive.imageGainBelow;
+      report["allocation"]["predicted_gain"] = r.predictedGain ? nlohmann::json(*r.predictedGain) : nlohmann::json();
+      report["allocation"]["kept_equal_counts"] = r.keptEqualCounts;
+    }
     if (methodTraits(run.method).split == Split::Probed)
       report["allocation"]["oracle_probe_spp"] = run.adaptive.oracleSamples;
     else
