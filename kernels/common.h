@@ -122,4 +122,9 @@ MA_FN MaVec3 scale3(MaVec3 a, float s) { return makeVec3(a.x * s, a.y * s, a.z *
 // double: misalloc::luminance (host/Constants.h), the same weights.
 MA_FN float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
+// The root mean square of a colour's channels: one number whose square is the mean of
+// the channels' squares, as the error over RGB that compare measures weighs them
+// (kernels/stats.h, storedSampleValue); luminance weighs blue by 0.07.
+MA_FN float channelRms(float r, float g, float b) { return ma_sqrt((r * r + g * g + b * b) * (1.0f / 3.0f)); }
+
 #endif

@@ -290,7 +290,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 #define STORED_AT(q) \
   (kept ? storedSampleIndex(pixel, i, (q), sampleCapacity, SAMPLE_COLUMNS) : spareSampleIndex(spareSamples, (q), lid))
         samples[STORED_AT(0)] = (float)storedColumn(c, MA_SHARE_COLUMNS);
-        samples[STORED_AT(1)] = c.y;
+        samples[STORED_AT(1)] = storedSampleValue(MA_STATS, c);
         MA_UNROLL
         for (int l = 0; l < SAMPLE_COLUMNS; ++l) samples[STORED_AT(2 + l)] = storedPdf(c, MA_SHARE_COLUMNS, l);
 #undef STORED_AT

@@ -70,12 +70,21 @@ MA_FN ma_acc statValue(int mask, int techniqueCount, int slot, SampleContributio
   return value;
 }
 
+// What a stored sample keeps of f: the root mean square of its channels (channelRms),
+// so that the allocations that weigh stored samples minimise the error over RGB, not
+// the luminance's alone (docs/results.md, "The allocation's colour"); with [Kon19]'s
+// optimal weights (MA_STATS_OPTIMAL) its luminance, in which their retargeted sums
+// take each technique's colour share from the running sums (docs/methods.md).
+MA_FN float storedSampleValue(int statsMask, SampleContribution c) {
+  return (statsMask & MA_STATS_OPTIMAL) ? c.y : channelRms(c.fr, c.fg, c.fb);
+}
+
 // Stored samples for the allocations that need every sample: linear with [SS23] eq. 19
 // keeps them all; the grid searches of exact and oracle (kernels/gridsearch.cl) keep
 // running sums and need only those taken since the previous search. Blocked by 16
 // pixels for float16 loads: value q of the pixel's sample in slot i is at
 // ((block·capacity + i)(C + 2) + q)·16 + lane, with q = 0 the column that drew it, 1
-// the luminance f, 2 + l the pdf of column l.
+// its value f (storedSampleValue), 2 + l the pdf of column l.
 //
 // The columns are the pdfs an allocation weighs: one per technique, or, with share
 // columns S > 0 (the optimal pdf's bank, for the grid search's rule (b)), the envmap's

@@ -240,6 +240,51 @@ TEST_CASE("a stored sample's share columns hold the pdf of each share, its own s
   }
 }
 
+// A stored sample's value (kernels/stats.h, storedSampleValue): the RMS of f's channels,
+// or its luminance with the optimal weights. The stage's luminance moments Σ Y(f)/p_α
+// per technique check it: with the optimal weights the stored values reproduce them;
+// without, they reproduce them under a grey map, where the two are one number (the
+// BRDFs are grey), and not under a coloured one.
+TEST_CASE("a stored sample keeps the RMS of its channels, and its luminance with optimal weights", "[sampler]") {
+  const int N = 8;
+  for (const std::string map : {"rooitou_park", "cosk:2"}) {
+    const Scene scene = smallScene(map, "seed000", 24, 16);
+    for (bool optimalWeights : {false, true}) {
+      SamplerConfig config{Estimator::MultiSample, 0, N};
+      config.optimalWeights = optimalWeights;
+      if (optimalWeights) config.statsMask |= MA_STATS_OPTIMAL;
+      for (bool device : {false, true}) {
+        std::unique_ptr<StageSampler> sampler;
+        if (device)
+          sampler = std::make_unique<Sampler>(testDevice(), scene, config);
+        else
+          sampler = std::make_unique<HostSampler>(scene, config);
+        const StagePlan plan = singleStagePlan(scene, Method::Equal, N);
+        const StageResult result = sampler->run(plan, 5);
+        const std::vector<float> stored = sampler->storedSamples();
+        int pixelsMatching = 0;
+        for (int p = 0; p < scene.pixelCount(); ++p) {
+          double sums[2] = {0, 0};
+          for (int i = 0; i < N; ++i) {
+            auto at = [&](int q) { return double(stored[kern::storedSampleIndex(p, i, q, N, 2)]); };
+            const double pAlpha = (plan.counts[2 * p] * at(2) + plan.counts[2 * p + 1] * at(3)) / N;
+            sums[int(at(0))] += pAlpha > 0 ? at(1) / pAlpha : 0.0;
+          }
+          bool matches = true;
+          for (int k = 0; k < 2; ++k) matches &= closeSums(sums[k], result.moments[(2 * p + k) * 2]);
+          pixelsMatching += matches;
+        }
+        INFO(fmt::format("{}, optimal weights {}, device {}: {} of {} pixels", map, optimalWeights, device,
+                         pixelsMatching, scene.pixelCount()));
+        if (optimalWeights || map == "cosk:2")
+          CHECK(pixelsMatching == scene.pixelCount());
+        else
+          CHECK(pixelsMatching < scene.pixelCount() / 10);
+      }
+    }
+  }
+}
+
 // ris's candidate loop, unrolled in the kernel and a loop in the reference. The default
 // candidates on a map whose kernel tests/test_devices.cpp builds too: PoCL compiles an
 // unrolled loop for seconds per candidate count (docs/pocl.md). On a cos^K map as well,
