@@ -1,5 +1,6 @@
 #pragma once
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 namespace misalloc {
@@ -12,5 +13,10 @@ std::string validUtf8(const std::string& text);
 // `json` indented by 2 with a final newline, every string and key made valid UTF-8
 // first, so that serialising a report never fails.
 std::string jsonText(const nlohmann::json& json);
+
+// The value, or null where there is none.
+inline nlohmann::json optionalJson(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json();
+}
 
 }  // namespace misalloc

@@ -27,7 +27,7 @@ nlohmann::json runRecordJson(const RunRecord& r) {
           {"fractions", {r.fallbackFraction, r.flooredFraction, r.skippedFraction, r.weightsFallbackFraction}},
           {"statistics_bytes_per_pixel", r.statisticsBytesPerPixel},
           {"costs_source", r.costSource},
-          {"predicted_gain", r.predictedGain ? nlohmann::json(*r.predictedGain) : nlohmann::json()},
+          {"predicted_gain", optionalJson(r.predictedGain)},
           {"kept_equal_counts", r.keptEqualCounts},
           {"stages", stagesJson(r.stages)}};
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "JsonText.h"
 #include "report/Report.h"
 
 namespace misalloc {
@@ -261,7 +262,7 @@ nlohmann::json summaryJson(const Summary& s) {
       for (const CurveValue& v : m.equalTimeRmseX1000) equalTime.push_back(curveValueJson(v));
       methods.push_back({{"method", methodName(m.method)},
                          {"budgets", budgets},
-                         {"log_log_slope", m.slope ? nlohmann::json(*m.slope) : nlohmann::json()},
+                         {"log_log_slope", optionalJson(m.slope)},
                          {"equal_time_rmse_x1000", equalTime}});
     }
     cases.push_back({{"label", c.info.label},

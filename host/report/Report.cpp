@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "JsonText.h"
 #include "KernelCode.h"
 #include "report/RunSummary.h"
 
@@ -218,7 +219,7 @@ nlohmann::json renderReport(const RenderRun& run) {
     }
     if (run.method == Method::Exact) {
       report["allocation"]["skip_image_below"] = run.adaptive.imageGainBelow;
-      report["allocation"]["predicted_gain"] = r.predictedGain ? nlohmann::json(*r.predictedGain) : nlohmann::json();
+      report["allocation"]["predicted_gain"] = optionalJson(r.predictedGain);
       report["allocation"]["kept_equal_counts"] = r.keptEqualCounts;
     }
     if (methodTraits(run.method).split == Split::Probed)
