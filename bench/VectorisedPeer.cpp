@@ -71,7 +71,7 @@ TechniqueSums techniquePass(PixelPass p) {
   p.env.coskExponent = -1.0f;  // the texels' radiance
   p.env.bankShares = 0;
   p.ts.techniqueCount = p.counts.techniqueCount = 2;
-  p.ts.splitBrdf = p.ts.sharePdfs = p.ts.product.tables = 0;
+  p.ts.splitBrdf = p.ts.sharePdfs = p.ts.product.tables = p.ts.product.pixelCells = 0;
   p.counts.oneSample = p.counts.countIndependent = p.counts.risCandidates = 0;
   const int n = Technique == 0 ? p.counts.n0 : p.counts.n1;
   const uint32_t first = kern::firstIndexOf(p.counts, Technique);

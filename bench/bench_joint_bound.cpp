@@ -112,7 +112,7 @@ std::vector<ProbeSample> probePixel(const Scene& scene, kern::EnvmapView env, in
   kern::TechniqueSet ts;
   ts.techniqueCount = 2;
   ts.splitBrdf = 0;
-  ts.product.tables = 0;
+  ts.product.tables = ts.product.pixelCells = 0;
   const kern::ShadingPoint sp = makeShadingPoint(scene, pixel);
   env.brdfBin = scene.tables.brdfBinOfPixel[pixel];
   const int probeShare = nearestShare(env, 0.5);

@@ -40,7 +40,7 @@ typedef struct {
 typedef struct {
   int techniqueCount;             // M
   int splitBrdf;                  // M = 3: the BRDF's lobes are techniques of their own
-  ProductView product;            // product.tables > 0: technique 2 is the product technique
+  ProductView product;            // productEnabled: technique 2 is the product technique
   ProductMixture productMixture;  // the pixel's (productMixture)
   int sharePdfs;                  // 1: evaluateSample also gives the envmap's pdf under every share's table
 } TechniqueSet;
@@ -51,7 +51,7 @@ typedef struct {
 } TechniqueSample;
 
 MA_FN int roleOf(TechniqueSet ts, int technique) {
-  return techniqueRole(ts.splitBrdf, ts.product.tables > 0, technique);
+  return techniqueRole(ts.splitBrdf, productEnabled(ts.product), technique);
 }
 
 MA_FN int isProductTechnique(TechniqueSet ts, int technique) { return roleOf(ts, technique) == ROLE_PRODUCT; }

@@ -107,7 +107,7 @@ MA_FN SampleContribution takeTechniqueSample(TechniqueSet ts, EnvmapView env, Sh
   float N = (float)c.stageSamples;
   float alpha[MA_MAX_TECHNIQUES];
   stageFractions(c, alpha);
-  float bankFraction = bankEnvmapFraction(ts.product.tables > 0, c.n0, c.n1, alpha[0]);
+  float bankFraction = bankEnvmapFraction(productEnabled(ts.product), c.n0, c.n1, alpha[0]);
   if (env.bankShares > 0) env.bankEntry = bankEntryOf(env, bankFraction);
   SampleValue s;
   float invP, scale;

@@ -14,7 +14,7 @@ enum { SUM_R, SUM_G, SUM_B, SUM_W0, SUM_W1, SUM_W2, SUM_WW0, SUM_WW1, SUM_WW2, S
 // What a pixel's samples share, one 32-bit word per row: its shading point (BRDF, BRDF
 // bin, normal, mirror direction), counts and first sample indices; then, with --weights
 // optimal, the coefficients a_{c,k} at row ROW_COEFFICIENTS + c·M + k; then, with
-// --product, its ProductMixture (diffuse, specular, specular table); then, with the
+// --product's tables, its ProductMixture (diffuse, specular, specular table); then, with the
 // optimal pdf per pixel, its CDF over the cells and the build's scratch
 // (kernels/pixel_optimal.h, MA_PIXEL_CDF_ROWS).
 enum {
@@ -44,16 +44,21 @@ enum {
 // The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
 // scratch, pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS), then
 // the scales of the tables of the share columns' shares, 1 + 3 per share for at most 3
-// shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES).
+// shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES), then with the product
+// technique from the same cells (productCells) its CDF's pixelCells + 1 entries.
 #define MA_PIXEL_CHUNKS 16
 #define MA_PIXEL_SHARE_ROWS 10
-#define MA_PIXEL_CDF_ROWS(pixelCells) \
-  ((pixelCells) > 0 ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS : 0)
-#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells) \
-  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells))
+#define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                      \
+  ((pixelCells) > 0 ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + \
+                          ((productCells) ? (pixelCells) + 1 : 0)                        \
+                    : 0)
+#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells) \
+  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells))
 
-MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells) {
-  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells);
+// product: the product technique's mixture rows (its tables, kernels/product.h);
+// productCells: its CDF over the optimal pdf's cells.
+MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells, int productCells) {
+  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells);
 }
 
 // The per-pixel buffers, pixel p's first element. Shading point words: the first

@@ -24,6 +24,11 @@
 // 3/4 would build: each sample then carries its pdf under each, and the search judges
 // each α_0 by the table of the share nearest it ([Kar19] Sec. 10's joint choice of the
 // pdf and the allocation), as it does with the bank's entries.
+//
+// The product technique ([CL18]) from the same cells (--product with this pdf): its table
+// is eq. 6 at C = 1, f/F with the same plain share, where BRDF sampling takes no part. Its
+// CDF is written beside the envmap's from the same f, in the same passes: per pixel, with
+// no table binned over BRDFs or geometry (kernels/product.h, ProductView::pixelCells).
 #include "namespace_check.h"
 #ifndef MA_PIXEL_OPTIMAL_H
 #define MA_PIXEL_OPTIMAL_H
@@ -54,6 +59,8 @@ enum {
   SHARE_ROWS = SHARE_PLAIN + MA_MAX_BANK_SHARES
 };
 #define MA_SHARE_ROW(count, q) (2 * (count) + 1 + CHUNK_SUMS * MA_PIXEL_CHUNKS + (q))
+// Then the product technique's CDF, count + 1 entries.
+#define MA_PRODUCT_CDF_ROW(count, c) (MA_SHARE_ROW(count, SHARE_ROWS) + (c))
 
 MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
 MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
@@ -174,27 +181,47 @@ MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, in
 // A cell's mass in the table, from its eq. 6 term and its plain mass.
 MA_FN float cellTableMass(PixelTableScales s, float eq6, float plain) { return s.optimal * eq6 + s.plain * plain; }
 
-MA_FN float chunkTableMass(MA_LOCAL const int* rows, int stride, int count, int j, PixelTableScales s) {
-  return cellTableMass(s, rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)),
+// A chunk's eq. 6 mass: pass 3's sum, or the product's (t.brdfScale = 0) Σ f times 1/F.
+MA_FN float chunkEq6Mass(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t, int product) {
+  return product ? rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j)) * t.invF
+                 : rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j));
+}
+
+MA_FN float chunkTableMass(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
+                           PixelTableScales s, int product) {
+  return cellTableMass(s, chunkEq6Mass(rows, stride, count, j, t, product),
                        rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j)));
+}
+
+// The product technique's terms and scales: eq. 6 at C = 1, its mass Σ f/F.
+MA_FN PixelOptimalTerms productTerms(MA_LOCAL const int* rows, int stride, int count) {
+  return pixelOptimalTerms(rows, stride, count, 1.0f);
+}
+
+MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
+  float mass = 0.0f;
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) mass += chunkEq6Mass(rows, stride, count, j, t, 1);
+  return tableScalesOf(t, mass, chunkTotal(rows, stride, count, CHUNK_PLAIN));
 }
 
 // Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
 // offset the table mass of the chunks before it, each entry at most the next chunk's
 // ⌈offset⌉: the CDF never falls across a chunk's edge, however the sums round. The last
-// entry is 1.
+// entry is 1. The envmap's CDF, or the product's (product); the product's first, since
+// the envmap's entries take the place of the chunk's f.
 MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
-                                MA_LOCAL int* rows, int stride) {
+                                int product, MA_LOCAL int* rows, int stride) {
+  int first = product ? MA_PRODUCT_CDF_ROW(count, 0) : MA_CDF_ROW(0);
   float offset = 0.0f;
-  for (int i = 0; i < j; ++i) offset += chunkTableMass(rows, stride, count, i, s);
-  float next = ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, s), 1.0f));
+  for (int i = 0; i < j; ++i) offset += chunkTableMass(rows, stride, count, i, t, s, product);
+  float next = ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
   float partial = 0.0f;
   for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
     partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cells[MA_CELL_FLOATS * c + 3]);
     float entry = ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next);
-    setRowFloat(rows, stride, MA_CDF_ROW(c + 1), c + 1 < count ? entry : 1.0f);
+    setRowFloat(rows, stride, first + c + 1, c + 1 < count ? entry : 1.0f);
   }
-  if (j == 0) setRowFloat(rows, stride, MA_CDF_ROW(0), 0.0f);
+  if (j == 0) setRowFloat(rows, stride, first, 0.0f);
 }
 
 // The share columns' share s of MA_MAX_BANK_SHARES: C_s = (s+1)/(shares+1), the bank's
@@ -218,18 +245,34 @@ MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
   }
 }
 
+// Pass 4 for chunk j: the product's CDF (with productCdf), then the envmap's.
+MA_FN void pixelOptimalChunkCdfs(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t,
+                                 PixelTableScales s, int productCdf, MA_LOCAL int* rows, int stride) {
+  if (productCdf) {
+    PixelOptimalTerms tp = productTerms(rows, stride, count);
+    pixelOptimalChunkCdf(cells, count, j, tp, productTableScales(rows, stride, count, tp), 1, rows, stride);
+  }
+  pixelOptimalChunkCdf(cells, count, j, t, s, 0, rows, stride);
+}
+
 // The whole build by one work-item (sampleStage, the C++ reference): the pixel's CDF over
 // `count` cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
-// `shareColumns`, the share columns' scales too.
+// `shareColumns`, the share columns' scales too; with `productCdf`, the product's CDF.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
-                                float envmapShare, int shareColumns, MA_LOCAL int* rows, int stride) {
+                                float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkSums(cells, count, j, rows, stride);
   PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkEq6(count, j, t, rows, stride);
   if (shareColumns) pixelOptimalShareScales(count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, t, s, rows, stride);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdfs(cells, count, j, t, s, productCdf, rows, stride);
+}
+
+// The product technique's view of the pixel's cells: the envmap's, over the product's CDF.
+MA_FN EnvmapView pixelProductView(EnvmapView env) {
+  env.pixelCdf += MA_PRODUCT_CDF_ROW(env.pixelCells, 0) * env.pixelCdfStride;
+  return env;
 }
 
 // The envmap's pdf at ω in texel t under the table of each share (stats.h's share

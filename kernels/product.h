@@ -7,12 +7,17 @@
 // a texel in it by its luminance × sin θ, as the optimal pdf's bank does (kernels/envmap.h):
 // the full resolution stays. Host side: host/distributions/ProductTables.h builds the
 // tables; the technique is technique 2 of kernels/estimator.h (`--product`).
+//
+// With the optimal pdf per pixel, whose pixels may each see the map from their own normal
+// and view, the product comes instead from the pixel's own cells (ProductView::pixelCells,
+// kernels/pixel_optimal.h): no table at all.
 #include "namespace_check.h"
 #ifndef MA_PRODUCT_H
 #define MA_PRODUCT_H
 #include "common.h"
 #include "envmap.h"
 #include "phong.h"
+#include "pixel_optimal.h"
 
 // Tables: 0 the plain envmap's blocks, 1 the diffuse product, 2 + i the specular product
 // of exponent bin i's table. A pixel's exponent bin splits each octave of n + 1 at 1.5×;
@@ -35,10 +40,14 @@
 typedef struct {
   MA_GLOBAL const float* floats;
   MA_GLOBAL const ma_uint* words;
-  int tables;       // 0: no product technique
+  int tables;       // 0: no tables (no product technique, or the pixel's cells')
   int blockLog2;    // blocks of 2^L × 2^L texels
   int plainTexels;  // 1: the envmap's own pdf is the plain one, so the product scales it
+  int pixelCells;   // 1: the product is the pixel's CDF over the optimal pdf's cells
 } ProductView;
+
+// Whether technique 2 is the product technique.
+MA_FN int productEnabled(ProductView p) { return p.tables > 0 || p.pixelCells; }
 
 MA_FN int productBlocksAcross(EnvmapView env, ProductView p) {
   return (env.width + (1 << p.blockLog2) - 1) >> p.blockLog2;
@@ -89,8 +98,10 @@ MA_FN float productRatio(EnvmapView env, ProductView p, ProductMixture m, int bl
 
 // The product's solid-angle pdf at ω in texel t for the pixel's mixture: the plain
 // envmap pdf there (plainPdf where the envmap's own pdf is plain, ProductView::plainTexels;
-// else from the texel's plain probability and ω's sinTheta) times productRatio.
+// else from the texel's plain probability and ω's sinTheta) times productRatio. From the
+// pixel's cells: the texel's probability in its cell times the cell's in the product's CDF.
 MA_FN float productPdf(EnvmapView env, ProductView p, ProductMixture m, int t, float plainPdf, float sinTheta) {
+  if (p.pixelCells) return envmapPdfOfTexel(env, texelProbability(pixelProductView(env), t), sinTheta);
   int row = rowOfIndex(t, env.width), col = t - row * env.width;
   int block = (row >> p.blockLog2) * productBlocksAcross(env, p) + (col >> p.blockLog2);
   float plain = p.plainTexels
@@ -100,8 +111,10 @@ MA_FN float productPdf(EnvmapView env, ProductView p, ProductMixture m, int t, f
 }
 
 // A direction from the pixel's product: the table by `mixtureU`, its block by rnd.v[0]
-// and v[1], the texel in the block and the jitter by v[2] and v[3] (sampleTexelInBlock).
+// and v[1], the texel in the block and the jitter by v[2] and v[3] (sampleTexelInBlock);
+// from the pixel's cells, as the envmap's cells draw (sampleEnvmapPixelCells).
 MA_FN EnvmapSample sampleProduct(EnvmapView env, ProductView p, ProductMixture m, MaRandom4 rnd, float mixtureU) {
+  if (p.pixelCells) return sampleEnvmapPixelCells(pixelProductView(env), rnd);
   int table = mixtureU < m.diffuse ? MA_PRODUCT_TABLE_DIFFUSE
                                    : (mixtureU < m.diffuse + m.specular ? m.specularTable : MA_PRODUCT_TABLE_PLAIN);
   int blocks = productBlocks(env, p);

@@ -11,7 +11,8 @@
 // MA_PRODUCT_TABLES, MA_PRODUCT_BLOCK_LOG2 and MA_PRODUCT_PLAIN_TEXELS (the product
 // technique's tables, kernels/product.h; 0: none), MA_PIXEL_CELLS and MA_PIXEL_CDF_STEPS
 // (the optimal pdf per pixel over that many blocks of 2^MA_BANK_BLOCK_LOG2 texels,
-// kernels/pixel_optimal.h; 0: none), MA_STATS (the
+// kernels/pixel_optimal.h; 0: none), MA_PRODUCT_CELLS (1: the product technique from
+// those cells, kernels/product.h), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
 // weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE, and for
@@ -45,7 +46,9 @@
 // (docs/pocl.md, "How misalloc's kernels apply them").
 #define ROW_PRODUCT MA_ROW_PRODUCT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES)
 #define ROW_PIXEL_CDF MA_ROW_PIXEL_CDF(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0)
-#define ROW_COUNT MA_PIXEL_ROW_COUNT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0, MA_PIXEL_CELLS)
+#define ROW_COUNT \
+  MA_PIXEL_ROW_COUNT(MA_OPTIMAL_WEIGHTS, MA_TECHNIQUES, MA_PRODUCT_TABLES > 0, MA_PIXEL_CELLS, MA_PRODUCT_CELLS)
+#define HAS_PRODUCT (MA_PRODUCT_TABLES > 0 || MA_PRODUCT_CELLS)
 
 MA_FN ProductView productView(__global const float* productFloats, __global const uint* productWords) {
   ProductView p;
@@ -54,6 +57,7 @@ MA_FN ProductView productView(__global const float* productFloats, __global cons
   p.tables = MA_PRODUCT_TABLES;
   p.blockLog2 = MA_PRODUCT_BLOCK_LOG2;
   p.plainTexels = MA_PRODUCT_PLAIN_TEXELS;
+  p.pixelCells = MA_PRODUCT_CELLS;
   return p;
 }
 
@@ -110,7 +114,7 @@ MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride,
   c.n0 = pixelRows[ROW_N0 * rowStride + column];
   c.n1 = pixelRows[ROW_N1 * rowStride + column];
   c.stageSamples = stageSamples;
-  in.envmapShare = stageEnvmapShare(MA_PRODUCT_TABLES > 0, c);
+  in.envmapShare = stageEnvmapShare(HAS_PRODUCT, c);
   return in;
 #undef ROW_FLOAT
 }
@@ -243,7 +247,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
     PixelCdfInputs in = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
     buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, MA_SHARE_COLUMNS > 0,
-                         pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid, MA_LOCAL_SIZE);
+                         MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid, MA_LOCAL_SIZE);
   }
 #endif
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so
@@ -376,7 +380,7 @@ MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* ce
   barrier(CLK_LOCAL_MEM_FENCE);
   PixelTableScales s = pixelTableScales(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, t);
   for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
-    pixelOptimalChunkCdf(cells, MA_PIXEL_CELLS, j, t, s, rows, PIXEL_ROW_STRIDE);
+    pixelOptimalChunkCdfs(cells, MA_PIXEL_CELLS, j, t, s, MA_PRODUCT_CELLS, rows, PIXEL_ROW_STRIDE);
   barrier(CLK_LOCAL_MEM_FENCE);
 }
 #endif

@@ -66,13 +66,14 @@ std::vector<PixelOptimalPoint> pixelOptimalPoints() {
   };
 }
 
-// The view of `point`'s own table for a stage of envmap share C, in `rows`.
+// The view of `point`'s own table for a stage of envmap share C, in `rows`; with
+// productCdf, the product technique's CDF beside it (kernels/pixel_optimal.h).
 kern::EnvmapView pixelOptimalView(const EnvmapTables& tables, const PixelOptimalPoint& point, float share,
-                                  bool shareColumns, std::vector<int>& rows) {
+                                  bool shareColumns, std::vector<int>& rows, bool productCdf = false) {
   kern::EnvmapView view = viewOf(tables);
-  rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells), 0);
+  rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells, productCdf), 0);
   kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror, share,
-                             shareColumns ? 1 : 0, rows.data(), 1);
+                             shareColumns ? 1 : 0, productCdf ? 1 : 0, rows.data(), 1);
   view.pixelCdf = rows.data();
   return view;
 }
@@ -80,13 +81,16 @@ kern::EnvmapView pixelOptimalView(const EnvmapTables& tables, const PixelOptimal
 // The texel that kernels/envmap.h's sampleEnvmap picks for these random numbers.
 int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) { return kern::sampleEnvmap(view, r).texel; }
 
-// `samples` texels drawn by the kernels' sampleEnvmap with Philox keyed (seedLo,
-// seedHi): none of probability 0, and a χ² test against p at `level`.
+// `samples` texels drawn by `draw` (by default the kernels' sampleEnvmap) with Philox
+// keyed (seedLo, seedHi): none of probability 0, and a χ² test against p at `level`.
 void checkDrawnTexels(const kern::EnvmapView& view, const std::vector<double>& p, uint64_t samples, uint32_t seedLo,
-                      uint32_t seedHi, double level) {
+                      uint32_t seedHi, double level,
+                      const std::function<int(const kern::MaRandom4&)>& draw = {}) {
   std::vector<uint64_t> counts(p.size(), 0);
-  for (uint64_t i = 0; i < samples; ++i)
-    ++counts[sampledTexel(view, kern::philoxDraw(seedLo, seedHi, 0, 0, uint32_t(i)))];
+  for (uint64_t i = 0; i < samples; ++i) {
+    const kern::MaRandom4 r = kern::philoxDraw(seedLo, seedHi, 0, 0, uint32_t(i));
+    ++counts[draw ? draw(r) : sampledTexel(view, r)];
+  }
   uint64_t zeroWeightDraws = 0;
   for (std::size_t t = 0; t < p.size(); ++t) zeroWeightDraws += p[t] == 0 ? counts[t] : 0;
   CHECK(zeroWeightDraws == 0);
@@ -484,15 +488,39 @@ TEST_CASE("the optimal pdf's bank draws texels with the probabilities it evaluat
     }
 }
 
+// The product technique from the pixel's cells (kernels/product.h, ProductView::pixelCells):
+// texel t's probability under it and the texel it draws, as estimator.h reads and draws.
+double productTexelProbability(const kern::EnvmapView& env, int t) {
+  kern::ProductView product{};
+  product.pixelCells = 1;
+  const float sinTheta = 0.5f;  // any: the pdf is the probability over the same Jacobian
+  return double(kern::productPdf(env, product, {}, t, 0.0f, sinTheta)) / kern::envmapPdfOfTexel(env, 1.0f, sinTheta);
+}
+
+int productDrawnTexel(const kern::EnvmapView& env, const kern::MaRandom4& r) {
+  kern::ProductView product{};
+  product.pixelCells = 1;
+  return kern::sampleProduct(env, product, {}, r, 0.0f).texel;
+}
+
+// The texel probabilities of a pixel's table: the envmap's, or the product's.
+std::vector<double> pixelTexelProbabilities(const kern::EnvmapView& view, bool product) {
+  std::vector<double> p(std::size_t(view.width) * view.height);
+  for (std::size_t t = 0; t < p.size(); ++t)
+    p[t] = product ? productTexelProbability(view, int(t)) : kern::texelProbability(view, int(t));
+  return p;
+}
+
 TEST_CASE(
     "the optimal pdf per pixel draws texels with the probabilities it evaluates, positive wherever the map is lit",
-    "[envmap][optimal]") {
+    "[envmap][optimal][product]") {
   // kernels/pixel_optimal.h: a cell by the pixel's own CDF, built from its normal, mirror
   // direction, BRDF and envmap share, then a texel of the cell by the plain weights, at
-  // every shading point of pixelOptimalPoints. A false alarm in any χ² test with
-  // probability 2 %.
+  // every shading point of pixelOptimalPoints; and the product technique's CDF built
+  // beside it (eq. 6 at C = 1), drawn and evaluated as kernels/product.h does. A false
+  // alarm in any χ² test with probability 2 %.
   const std::vector<PixelOptimalPoint> points = pixelOptimalPoints();
-  const double level = misalloc::test::sidakLevel(0.02, int(std::size(points) * testMaps().size()));
+  const double level = misalloc::test::sidakLevel(0.02, int(2 * std::size(points) * testMaps().size()));
   for (const auto& [name, map] : testMaps()) {
     EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
     INFO(name);
@@ -506,21 +534,41 @@ TEST_CASE(
     const std::vector<double> plain = misalloc::plainTexelWeights(map.image);
     for (const PixelOptimalPoint& point : points) {
       INFO(point.name);
-      std::vector<int> rows;
+      std::vector<int> rows, withProduct, atShareOne;
       kern::EnvmapView view = pixelOptimalView(tables, point, point.share, false, rows);
-      std::vector<double> p(std::size_t(tables.width) * tables.height);
-      double sum = 0;
-      std::size_t unlit = 0;
-      for (std::size_t t = 0; t < p.size(); ++t) {
-        sum += p[t] = kern::texelProbability(view, int(t));
-        unlit += plain[t] > 0 && !(p[t] > 0);
+      // The product's CDF leaves the envmap's as it was, bit for bit.
+      const kern::EnvmapView both = pixelOptimalView(tables, point, point.share, false, withProduct, true);
+      CHECK(std::equal(rows.begin(), rows.end(), withProduct.begin()));
+      const kern::EnvmapView product = kern::pixelProductView(both);
+      for (bool isProduct : {false, true}) {
+        INFO((isProduct ? "the product's table" : "the envmap's table"));
+        const std::vector<double> p = pixelTexelProbabilities(isProduct ? both : view, isProduct);
+        double sum = 0;
+        std::size_t unlit = 0;
+        for (std::size_t t = 0; t < p.size(); ++t) {
+          sum += p[t];
+          unlit += plain[t] > 0 && !(p[t] > 0);
+        }
+        // A cell's and a texel's probability, each rounded to float, and their product.
+        CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
+        CHECK(unlit == 0);
+        const uint32_t seedHi = uint32_t(&point - points.data()) + (isProduct ? 0x100u : 0u);
+        if (isProduct)
+          checkDrawnTexels(both, p, 200000, 0x9e1, seedHi, level,
+                           [&](const kern::MaRandom4& r) { return productDrawnTexel(both, r); });
+        else
+          checkDrawnTexels(view, p, 200000, 0x9e1, seedHi, level);
       }
-      // A cell's and a texel's probability, each rounded to float, and their product.
-      CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
-      CHECK(unlit == 0);
-      checkDrawnTexels(view, p, 200000, 0x9e1, uint32_t(&point - points.data()), level);
       // The pdf a BRDF-sampled direction reads, by the midpoint rule.
       CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
+      // The product is the envmap's table at C = 1, f/F ([CL18] from the cells), its chunks'
+      // masses rounded apart: each cell within a few steps of the CDF's grid.
+      const kern::EnvmapView shareOne = pixelOptimalView(tables, point, 1.0f, false, atShareOne);
+      double worst = 0;
+      for (int c = 0; c < tables.pixelCells; ++c)
+        worst = std::max(worst, std::abs(double(kern::pixelCellProbability(product, c)) -
+                                         kern::pixelCellProbability(shareOne, c)));
+      CHECK(worst <= 8 / kGrid24);
     }
   }
 }
@@ -580,9 +628,9 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(tall);
   REQUIRE(tables.pixelCells == MA_MAX_PIXEL_CELLS);
   kern::EnvmapView view = viewOf(tables);
-  std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells));
+  std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells, 0));
   const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
-  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 0,
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 0, 0,
                              rows.data(), 1);
   view.pixelCdf = rows.data();
   std::vector<double> p(std::size_t(tables.width) * tables.height);

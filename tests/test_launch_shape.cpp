@@ -35,7 +35,7 @@ int statSlotsOf(Method method, bool split) {
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
   return
-      [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0)); };
+      [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0, 0)); };
 }
 
 bool hasFp64(const cl::Device& device) {
@@ -53,11 +53,12 @@ TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, t
   // The pixel's rows: BRDF (4), normal (3), mirror direction (3), counts (3), first
   // indices (3); 3M coefficients; 3 product; the optimal pdf per pixel's CDF over its
   // cells (cells + 1), its scratch (cells), 4 sums per chunk of cells and the share
-  // columns' scales.
-  CHECK(kern::pixelRowCount(0, 2, 0, 0) == 16);
-  CHECK(kern::pixelRowCount(1, 2, 0, 0) == 22);
-  CHECK(kern::pixelRowCount(1, 3, 1, 0) == 28);
-  CHECK(kern::pixelRowCount(0, 2, 0, 128) == 16 + 129 + 128 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS);
+  // columns' scales; the product's CDF over the same cells (cells + 1).
+  CHECK(kern::pixelRowCount(0, 2, 0, 0, 0) == 16);
+  CHECK(kern::pixelRowCount(1, 2, 0, 0, 0) == 22);
+  CHECK(kern::pixelRowCount(1, 3, 1, 0, 0) == 28);
+  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0) == 16 + 129 + 128 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS);
+  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1) == 16 + 129 + 128 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + 129);
   static_assert(kern::SHARE_ROWS == MA_PIXEL_SHARE_ROWS, "the share columns' rows of kernels/pixel_optimal.h");
 }
 
@@ -155,7 +156,8 @@ TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the b
     options.weights = optimal ? MisWeights::Optimal : MisWeights::Balance;
     SamplerConfig config = samplerConfigFor(methods[method], Estimator::MultiSample, 64, options);
     const int statSlots = HostSampler(scene, config).statSlots();
-    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), product, scene.tables.pixelCells);
+    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), scene.productTables.tables > 0,
+                                              scene.tables.pixelCells, scene.productTables.pixelCells);
     CAPTURE(split, product, methodName(methods[method]), optimal, pixelPdf, localSize);
     cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
     CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==

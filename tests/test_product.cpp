@@ -186,15 +186,19 @@ TEST_CASE("estimators with the product technique are unbiased against [HS14] eq.
     const Case& c = cases[i];
     uint64_t seed = 900 + uint64_t(64 * i);
     const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
-    for (const std::string pdf : {"plain", "compensated", "optimal"})
+    for (const std::string pdf : {"plain", "compensated", "optimal", "optimal-pixel"})
       for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
         // The other pdfs on two BRDFs, multi-sample: the cases the sweep ran when each K
-        // was a PoCL kernel of its own, under the same seeds.
-        const bool plain = pdf == "plain";
+        // was a PoCL kernel of its own, under the same seeds. The optimal pdf per pixel,
+        // whose product comes from its cells, with one-sample MIS too; it draws its cells
+        // by its own CDF, whatever the sampler.
+        const bool plain = pdf == "plain", pixelCells = pdf == "optimal-pixel";
         if (!plain && i % 2 == 1) continue;
+        if (pixelCells && s == EnvmapSampler::Cdf) continue;
         const Scene scene = productScene(fmt::format("cosk:{}", c.K),
                                          fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), 32, 32, 0, pdf, s);
         REQUIRE(scene.techniqueCount() == 3);
+        REQUIRE(scene.productTables.pixelCells == pixelCells);
         // The product alone, the three techniques in equal counts, and one-sample MIS.
         struct Run {
           const char* name;
@@ -204,7 +208,7 @@ TEST_CASE("estimators with the product technique are unbiased against [HS14] eq.
         for (const Run& run :
              {Run{"product alone", true, Estimator::MultiSample}, Run{"equal", false, Estimator::MultiSample},
               Run{"equal one-sample", false, Estimator::OneSample}}) {
-          if (!plain && run.estimator == Estimator::OneSample) continue;
+          if (!plain && !pixelCells && run.estimator == Estimator::OneSample) continue;
           auto renderMean = [&](int spp, uint64_t sd) {
             StagePlan plan = singleStagePlan(scene, Method::Equal, spp);
             if (run.productAlone)
@@ -232,6 +236,25 @@ TEST_CASE("the product technique with split lobes is refused: 4 techniques", "[p
   o.splitBrdf = o.product = true;
   o.envmapPdf = parseEnvmapPdf("plain");
   CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --split-brdf: not implemented"));
+}
+
+TEST_CASE("on per-pixel normals and views the product comes from the optimal pdf per pixel's cells, and its tables are refused",
+          "[product][geometry][bad-input]") {
+  SceneOptions o;
+  o.envmap = "sun";
+  o.proceduralWidth = 64;
+  o.shape = "sphere";
+  o.width = o.height = 16;
+  o.product = true;
+  o.envmapPdf = parseEnvmapPdf("plain");
+  CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --envmap-pdf plain and per-pixel normals or "
+                                                            "views: not implemented"));
+  o.envmapPdf = parseEnvmapPdf("optimal-pixel");
+  const Scene scene = makeScene(o);
+  CHECK(scene.techniqueNames() == std::vector<std::string>{"envmap", "brdf", "product"});
+  CHECK(scene.productTables.pixelCells);
+  CHECK(scene.productTables.tables == 0);  // no table binned over BRDFs or geometry
+  CHECK(scene.tables.pixelCells > 0);
 }
 
 TEST_CASE("BRDF sampling alone gives the product technique no samples: technique 2 is the product, not a lobe",
@@ -279,4 +302,31 @@ TEST_CASE("compare --product runs the methods that sample it, one scene with eve
   CHECK(ris.exitCode == 2);
   CHECK(ris.output.find("--product with --method ris") != std::string::npos);
   CHECK_FALSE(fs::exists(dir.path / "ris"));
+}
+
+TEST_CASE("compare --product on per-pixel geometry runs the optimal pdf per pixel alone, and refuses the plain pdf",
+          "[product][compare][cli][bad-input]") {
+  TempDir dir("compare_product_cells");
+  const std::string args = fmt::format(
+      "compare --scene sphere --envmap sun --size 16x16 --product --methods equal,exact --budgets 16 --repeats 1 "
+      "--reference-spp 64 --cost 1,1,2 --device host --cache-dir {} ",
+      (dir.path / "cache").string());
+  auto cells = runMisalloc(args + "--out-dir " + (dir.path / "cells").string());
+  INFO(cells.output);
+  REQUIRE(cells.exitCode == 0);
+  const auto runs = nlohmann::json::parse(readText(dir.path / "cells" / "runs.json"));
+  std::set<std::string> cases;
+  for (const auto& run : runs["runs"]) cases.insert(run["case"].get<std::string>());
+  CHECK(cases == std::set<std::string>{"sun-sphere-product-optimal-pixel"});
+  auto plain = runMisalloc(args + "--envmap-pdfs plain,optimal-pixel --out-dir " + (dir.path / "plain").string());
+  CHECK(plain.exitCode == 2);
+  CHECK(plain.output.find("--product with --envmap-pdfs plain on per-pixel normals or views: not implemented") !=
+        std::string::npos);
+  CHECK_FALSE(fs::exists(dir.path / "plain"));
+  auto render = runMisalloc(fmt::format("render --scene sphere --envmap sun --size 16x16 --product --envmap-pdf plain "
+                                        "--spp 8 --out {}",
+                                        (dir.path / "render.exr").string()));
+  CHECK(render.exitCode == 2);
+  CHECK(render.output.find("--product with --envmap-pdf plain and per-pixel normals or views") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir.path / "render.exr"));
 }

@@ -91,6 +91,9 @@ void writeBackLists(CompareArgs& args, const CompareOptions& compare, const std:
 int runCompare(CompareArgs& args) {
   InterruptionGuard guard;  // first: every thread started from here on inherits its mask
   CompareOptions& compare = args.compare;
+  // The probe below is a plain scene (compare takes its pdfs from --envmap-pdfs), but on
+  // per-pixel geometry the product exists only with the optimal pdf per pixel's cells.
+  if (args.scene.parsed().productFromPixelCells()) args.scene.envmapPdf = "optimal-pixel";
   if (args.suite) {
     for (const char* sceneOption : {"--envmap", "--grid", "--envmap-sampler", "--split-brdf"})
       if (args.command->count(sceneOption) > 0)
@@ -112,11 +115,18 @@ int runCompare(CompareArgs& args) {
     // The optimal pdf's bank has no split lobes: the default is then the plain pdf alone.
     if (probe.options.splitBrdf && args.command->count("--envmap-pdfs") == 0) args.envmapPdfs = "plain";
   }
-  // Nor per-pixel normals and views: each pixel's own optimal pdf stands in.
-  if (compare.cases.front().scene.perPixelGeometry() && args.command->count("--envmap-pdfs") == 0 &&
-      !compare.cases.front().scene.splitBrdf)
-    args.envmapPdfs = "plain,optimal-pixel";
+  // Nor per-pixel normals and views: each pixel's own optimal pdf stands in, and alone
+  // where the product technique comes from its cells.
+  const SceneOptions& first = compare.cases.front().scene;
+  if (first.perPixelGeometry() && args.command->count("--envmap-pdfs") == 0 && !first.splitBrdf)
+    args.envmapPdfs = first.productFromPixelCells() ? "optimal-pixel" : "plain,optimal-pixel";
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
+  for (const EnvmapPdf& pdf : pdfs)
+    if (first.productFromPixelCells() && !pdf.pixelOptimal())
+      throw InputError(fmt::format(
+          "--product with --envmap-pdfs {} on per-pixel normals or views: not implemented; only optimal-pixel "
+          "builds the product there, from each pixel's cells",
+          envmapPdfName(pdf)));
   const std::vector<MisWeights> weights = parseWeightsList(args.weights);
   const ShardUnit unit = parseShardUnit(args.shardUnit, "--shard-unit");
   compare.methods = parseMethodList(args.methods);

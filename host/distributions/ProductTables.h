@@ -3,7 +3,9 @@
 // reads them: over blocks of the map, the plain envmap's table, the diffuse product
 // L cos and one specular product L cos^n α cos per exponent bin that the grid's pixels
 // fall in; within each block, the texels by luminance × sin θ. A pixel's product mixes
-// them with its own BRDF's weights (productMixture), so no table is per pixel.
+// them with its own BRDF's weights (productMixture), so no table is per pixel. With the
+// optimal pdf per pixel the product is the pixel's own table over its cells
+// (kernels/pixel_optimal.h), and there are no tables (pixelCells).
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -23,9 +25,11 @@ struct ProductTables {
   // (the plain pdf, no bank, the alias sampler's stored weights): kernels/product.h
   // then scales the envmap's pdf instead of reading its own. Set by makeScene.
   bool plainTexels = false;
+  // The product from the optimal pdf per pixel's cells: no tables. Set by makeScene.
+  bool pixelCells = false;
   double buildSeconds = 0;
 
-  bool enabled() const { return tables > 0; }
+  bool enabled() const { return tables > 0 || pixelCells; }
   std::size_t bytes() const { return floats.size() * sizeof(float) + words.size() * sizeof(uint32_t); }
 };
 

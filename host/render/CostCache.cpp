@@ -161,6 +161,7 @@ std::string costCacheKey(const StageSampler& sampler, const Scene& image) {
   addTables(h, sampler.scene().tables);
   const ProductTables& product = sampler.scene().productTables;
   h.addValue(product.tables);
+  h.addValue(product.pixelCells);
   h.addVector(product.floats);
   h.addVector(product.words);
   // The image's map, size, view, frames and BRDFs, as its reference is keyed.

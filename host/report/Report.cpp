@@ -116,8 +116,11 @@ nlohmann::json sceneJson(const Scene& scene) {
                          {"techniques", scene.techniqueNames()},
                          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
                          {"envmap_pdf", envmapPdfJson(scene.tables)}};
-  if (scene.productTables.enabled())
-    json["product"] = {{"tables", scene.productTables.tables},
+  if (scene.productTables.pixelCells)
+    json["product"] = {{"from", "pixel_cells"}, {"plain_share", MA_PIXEL_PLAIN_SHARE}, {"table_bytes", 0}};
+  else if (scene.productTables.enabled())
+    json["product"] = {{"from", "tables"},
+                       {"tables", scene.productTables.tables},
                        {"specular_tables", scene.productTables.tables - MA_PRODUCT_TABLE_DIFFUSE - 1},
                        {"block_texels", 1 << (2 * scene.productTables.blockLog2)},
                        {"plain_share", MA_PRODUCT_PLAIN_SHARE},

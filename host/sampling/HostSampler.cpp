@@ -42,6 +42,7 @@ kern::ProductView makeProductView(const ProductTables& t) {
   p.tables = t.tables;
   p.blockLog2 = t.blockLog2;
   p.plainTexels = t.plainTexels ? 1 : 0;
+  p.pixelCells = t.pixelCells ? 1 : 0;
   return p;
 }
 
@@ -126,11 +127,11 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
                               config_.estimator == Estimator::OneSample,
                               config_.estimator == Estimator::CountIndependent, config_.risCandidates);
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
-    std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells));
+    std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
       kern::buildPixelOptimalCdf(scene_.tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z,
-                                 sp.mirrorFrame.z, kern::stageEnvmapShare(ts.product.tables > 0, c), ts.sharePdfs,
-                                 pixelCdf.data(), 1);
+                                 sp.mirrorFrame.z, kern::stageEnvmapShare(kern::productEnabled(ts.product), c),
+                                 ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(), 1);
       pixelEnv.pixelCdf = pixelCdf.data();
     }
     kern::PixelSums sums = kern::zeroPixelSums();

@@ -183,7 +183,15 @@ Scene makeScene(const SceneOptions& options) {
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
-  if (options.product) {
+  if (options.product && options.envmapPdf.pixelOptimal()) {
+    // The product from each pixel's own cells, whatever its normal and view.
+    scene.productTables.pixelCells = true;
+  } else if (options.product) {
+    if (!scene.geometry.flat())
+      throw InputError(fmt::format(
+          "--product with --envmap-pdf {} and per-pixel normals or views: not implemented; its tables are built for "
+          "one normal and view (with --envmap-pdf optimal-pixel, each pixel builds its own)",
+          envmapPdfName(options.envmapPdf)));
     scene.productTables = buildProductTables(scene.envmap, scene.grid, flatMirror(scene.geometry, "--product"));
     const EnvmapTables& t = scene.tables;
     scene.productTables.plainTexels = t.pdf.plain() && !t.hasBank() && !t.useCdf;

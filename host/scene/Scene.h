@@ -41,6 +41,9 @@ struct SceneOptions {
   // Whether each pixel has a normal and view of its own (not [HS14]'s plane), for which
   // the optimal pdf and the product technique are not implemented.
   bool perPixelGeometry() const;
+  // --product on per-pixel geometry: it comes from the optimal pdf per pixel's cells,
+  // the only pdf that allows it there.
+  bool productFromPixelCells() const { return product && perPixelGeometry(); }
 
   // What technique k samples: kern::ROLE_ENVMAP, ROLE_BRDF, ... (kernels/estimator.h).
   int techniqueRole(int technique) const;

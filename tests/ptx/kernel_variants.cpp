@@ -71,9 +71,10 @@ Scene scene(const std::string& envmap, bool split, bool product, EnvmapSampler s
 // takes them (render/RunChecks.h), at each work-group size, and the grid search where
 // the config asks for one (Sampler's constructor); not those of runs that
 // requireValidRun refuses (ris with the optimal pdf). The optimal pdf's bank and the
-// optimal pdf per pixel (M = 2 only) on one map: the map changes MA_ANALYTIC_RADIANCE alone. Work-groups of the CPU's
+// optimal pdf per pixel on one map: the map changes MA_ANALYTIC_RADIANCE alone. Work-groups of the CPU's
 // size and the largest GPU's: the size changes the local arrays' lengths alone, which `clang -S` does not hold against
-// a device's limits. The product technique (M = 3 as with split lobes, its tables' count compiled in) on one map. A
+// a device's limits. The product technique (M = 3 as with split lobes, its tables' count compiled in, or from the
+// optimal pdf per pixel's cells) on one map. A
 // CPU's samplePixelStage (alias sampler, no resampling) at 8 and 16 lanes.
 std::set<Variant> hostVariants() {
   std::set<Variant> variants;
