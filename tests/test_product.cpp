@@ -16,12 +16,14 @@
 #include "Constants.h"
 #include "Error.h"
 #include "KernelCode.h"
+#include "PictureChecks.h"
 #include "SafetyWorkspace.h"
 #include "SceneFixtures.h"
 #include "Statistics.h"
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "render/Render.h"
+#include "report/AlphaMap.h"
 #include "sampling/HostSampler.h"
 #include "sampling/KernelViews.h"
 
@@ -35,6 +37,18 @@ constexpr double kFloatRounding = 0x1p-24;
 Scene productScene(const std::string& envmap, const std::string& grid, int w, int h, double viewTheta,
                    const std::string& pdf = "plain", EnvmapSampler sampler = EnvmapSampler::Alias) {
   return smallScene(envmap, grid, w, h, false, sampler, viewTheta, pdf, true);
+}
+
+// A sphere under a sun, 16 × 16 pixels, with the product technique and `pdf`.
+SceneOptions productSphere(const std::string& pdf) {
+  SceneOptions o;
+  o.envmap = "sun";
+  o.proceduralWidth = 64;
+  o.shape = "sphere";
+  o.width = o.height = 16;
+  o.product = true;
+  o.envmapPdf = parseEnvmapPdf(pdf);
+  return o;
 }
 
 kern::PhongParams phongOf(const PhongParameters& p) {
@@ -240,17 +254,10 @@ TEST_CASE("the product technique with split lobes is refused: 4 techniques", "[p
 
 TEST_CASE("on per-pixel normals and views the product comes from the optimal pdf per pixel's cells, and its tables are refused",
           "[product][geometry][bad-input]") {
-  SceneOptions o;
-  o.envmap = "sun";
-  o.proceduralWidth = 64;
-  o.shape = "sphere";
-  o.width = o.height = 16;
-  o.product = true;
-  o.envmapPdf = parseEnvmapPdf("plain");
-  CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --envmap-pdf plain and per-pixel normals or "
-                                                            "views: not implemented"));
-  o.envmapPdf = parseEnvmapPdf("optimal-pixel");
-  const Scene scene = makeScene(o);
+  CHECK_THROWS_WITH(makeScene(productSphere("plain")),
+                    Catch::Matchers::Contains("--product with --envmap-pdf plain and per-pixel normals or views: not "
+                                              "implemented"));
+  const Scene scene = makeScene(productSphere("optimal-pixel"));
   CHECK(scene.techniqueNames() == std::vector<std::string>{"envmap", "brdf", "product"});
   CHECK(scene.productTables.pixelCells);
   CHECK(scene.productTables.tables == 0);  // no table binned over BRDFs or geometry
@@ -329,4 +336,31 @@ TEST_CASE("compare --product on per-pixel geometry runs the optimal pdf per pixe
   CHECK(render.exitCode == 2);
   CHECK(render.output.find("--product with --envmap-pdf plain and per-pixel normals or views") != std::string::npos);
   CHECK_FALSE(fs::exists(dir.path / "render.exr"));
+}
+
+TEST_CASE("the α map's picture shows the product technique's share in green", "[product][outputs]") {
+  // [HS14] Fig. 5.5's colours, blue for envmap sampling and red for BRDF sampling, with
+  // the product's share green: the product's samples are neither.
+  const Scene scene = makeScene(productSphere("optimal-pixel"));
+  AdaptiveOptions options;
+  options.costs = {1, 1, 1};
+  HostSampler sampler(scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, 64, options));
+  const Rendering r = render(sampler, Method::Exact, options, 64, 3);
+  const std::vector<uint8_t> picture = decodePng(encodeAlphaMaps(scene, r).png).rgb;
+  size_t misdrawn = 0, covered = 0, green = 0;
+  for (size_t p = 0; p < size_t(scene.pixelCount()); ++p) {
+    const uint8_t* rgb = picture.data() + 3 * p;
+    const double envmap = r.alpha[3 * p], brdf = r.alpha[3 * p + 1], product = r.alpha[3 * p + 2];
+    if (!scene.geometry.covered[p]) {
+      misdrawn += rgb[0] + rgb[1] + rgb[2] != 0;
+      continue;
+    }
+    ++covered;
+    green += rgb[1] > 0;
+    misdrawn += std::abs(rgb[0] - 255 * brdf) > 0.5 || std::abs(rgb[1] - 255 * product) > 0.5 ||
+                std::abs(rgb[2] - 255 * envmap) > 0.5;
+  }
+  CHECK(covered > 0);
+  CHECK(green == covered);  // the defensive floor gives every technique some samples
+  CHECK(misdrawn == 0);
 }

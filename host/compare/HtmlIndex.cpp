@@ -24,7 +24,8 @@ std::string image(const std::string& path, const std::string& title) {
 }
 
 // Rows = methods, columns = budgets: each repeat-0 preview, then the α map at the
-// table budget (blue = envmap sampling, red = BRDF sampling, as [HS14] Fig. 5.5).
+// table budget (blue = envmap sampling, red = BRDF sampling, as [HS14] Fig. 5.5; green
+// = the product technique).
 std::string imageGrid(const Summary& s, const CaseSummary& c) {
   std::string out = "<table>\n<tr><th>method</th>";
   for (int b : s.budgets) out += fmt::format("<th>{} spp</th>", b);

@@ -1,8 +1,10 @@
 #include "report/AlphaMap.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "AtomicFile.h"
+#include "KernelCode.h"
 #include "scene/PngIO.h"
 
 namespace misalloc {
@@ -22,9 +24,12 @@ AlphaMapFiles encodeAlphaMaps(const Scene& scene, const Rendering& rendering) {
   for (size_t p = 0; p < size_t(W) * H; ++p) {
     for (int k = 0; k < M; ++k) planes[k][p] = float(rendering.alpha[p * M + k]);
     if (!rendering.image.covers(p)) continue;  // the background took no samples: black
-    double envmap = rendering.alpha[p * M];
-    rgb[3 * p + 0] = uint8_t(std::lround(255 * (1 - envmap)));
-    rgb[3 * p + 2] = uint8_t(std::lround(255 * envmap));
+    double share[3] = {0, 0, 0};  // red, green, blue
+    for (int k = 0; k < M; ++k) {
+      const int role = scene.options.techniqueRole(k);
+      share[role == kern::ROLE_ENVMAP ? 2 : role == kern::ROLE_PRODUCT ? 1 : 0] += rendering.alpha[p * M + k];
+    }
+    for (int c = 0; c < 3; ++c) rgb[3 * p + c] = uint8_t(std::lround(255 * std::clamp(share[c], 0.0, 1.0)));
   }
   return {encodeExrChannels(W, H, names, planes), encodePng(W, H, rgb)};
 }

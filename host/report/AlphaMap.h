@@ -7,8 +7,8 @@ namespace misalloc {
 
 // The per-pixel allocation as two files: an EXR with one channel alpha.<technique>
 // per technique, and a false-colour PNG as in [HS14] Fig. 5.5: blue = envmap sampling
-// only, red = BRDF sampling only (both lobes when split), black the background, which
-// took no samples.
+// only, red = BRDF sampling only (both lobes when split), green = the product technique
+// only (--product), black the background, which took no samples.
 struct AlphaMapFiles {
   std::string exr, png;
 };
