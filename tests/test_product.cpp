@@ -364,3 +364,24 @@ TEST_CASE("the α map's picture shows the product technique's share in green", "
   CHECK(green == covered);  // the defensive floor gives every technique some samples
   CHECK(misdrawn == 0);
 }
+
+TEST_CASE("under a black map the product falls back with the optimal pdf per pixel, on per-pixel geometry too",
+          "[product][geometry][finite]") {
+  // The optimal pdf per pixel falls back to plain where nothing is lit, and has no cells
+  // for the product to come from: its tables then hold the plain envmap's alone.
+  SceneOptions o = productSphere("optimal-pixel");
+  o.envmap = "constant:0";
+  const Scene scene = makeScene(o);
+  CHECK(scene.tables.pixelCells == 0);
+  CHECK_FALSE(scene.productTables.pixelCells);
+  CHECK(scene.productTables.tables > 0);
+  for (Method method : {Method::Equal, Method::Exact}) {
+    AdaptiveOptions options;
+    options.costs = {1, 1, 1};
+    HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, 32, options));
+    const Rendering r = render(sampler, method, options, 32, 5);
+    size_t nonZero = 0;
+    for (float v : r.image.rgb) nonZero += v != 0.0f;
+    CHECK(nonZero == 0);
+  }
+}

@@ -183,16 +183,20 @@ Scene makeScene(const SceneOptions& options) {
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
-  if (options.product && options.envmapPdf.pixelOptimal()) {
+  if (options.product && scene.tables.pixelCells > 0) {
     // The product from each pixel's own cells, whatever its normal and view.
     scene.productTables.pixelCells = true;
   } else if (options.product) {
-    if (!scene.geometry.flat())
+    // Under a black map the optimal pdf per pixel falls back to plain, and the product's
+    // tables hold the plain envmap's alone (nothing is lit): any normal and view will do.
+    const bool black = options.envmapPdf.pixelOptimal();
+    if (!black && !scene.geometry.flat())
       throw InputError(fmt::format(
           "--product with --envmap-pdf {} and per-pixel normals or views: not implemented; its tables are built for "
           "one normal and view (with --envmap-pdf optimal-pixel, each pixel builds its own)",
           envmapPdfName(options.envmapPdf)));
-    scene.productTables = buildProductTables(scene.envmap, scene.grid, flatMirror(scene.geometry, "--product"));
+    scene.productTables = buildProductTables(scene.envmap, scene.grid,
+                                             black ? Vec3f{0.0f, 0.0f, 1.0f} : flatMirror(scene.geometry, "--product"));
     const EnvmapTables& t = scene.tables;
     scene.productTables.plainTexels = t.pdf.plain() && !t.hasBank() && !t.useCdf;
   }
