@@ -343,8 +343,7 @@ __kernel void selectPooled(__global const float* scores, __global const float* s
                            int width, int height, int radius, __global const float* gridLanes,
                            __global const float* gridCost, int gridSize, int paddedSize, int equal, float minGain,
                            __global float* alphaOut, __global int* selectedOut, __global uint* fallbacksOut,
-                           __global uchar* skippedOut, __global float* varianceRatioOut,
-                           __global float* heldOutOut) {
+                           __global uchar* skippedOut, __global float* varianceRatioOut, __global float* heldOutOut) {
   int pixel = (int)get_global_id(0);
   if (pixel >= width * height) return;
   PoolWindow w = poolWindow(pixel, width, height, radius, surfaces[pixel]);

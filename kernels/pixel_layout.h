@@ -48,10 +48,10 @@ enum {
 // technique from the same cells (productCells) its CDF's pixelCells + 1 entries.
 #define MA_PIXEL_CHUNKS 16
 #define MA_PIXEL_SHARE_ROWS 10
-#define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                      \
-  ((pixelCells) > 0 ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + \
-                          ((productCells) ? (pixelCells) + 1 : 0)                        \
-                    : 0)
+#define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                                                 \
+  ((pixelCells) > 0                                                                                                 \
+       ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
+       : 0)
 #define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells) \
   (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells))
 

@@ -246,8 +246,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The background takes no samples and needs no table.
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
     PixelCdfInputs in = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
-    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, MA_SHARE_COLUMNS > 0,
-                         MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid, MA_LOCAL_SIZE);
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare,
+                         MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
+                         MA_LOCAL_SIZE);
   }
 #endif
   // Multi-sample: technique k's n_k samples in turn, the order of takeStageSample, so

@@ -202,7 +202,8 @@ TEST_CASE("the pilot weighs less where the neighbours predict that alpha beats e
         Approx(0.05).margin(0.05 * double(flat.pixelCount() - skipped.skippedPixels) / flat.pixelCount()));
 }
 
-TEST_CASE("exact keeps equal counts for the whole image where its held-out pilot predicts no gain", "[adaptive][image]") {
+TEST_CASE("exact keeps equal counts for the whole image where its held-out pilot predicts no gain",
+          "[adaptive][image]") {
   // The flat case of the skip rule: no α gains much, but a third of the pixels adapt to
   // noise (above). The pixels' own samples, which did not choose their α, predict the
   // image's gain without that selection's optimism: 1.006 in geometric mean over 8

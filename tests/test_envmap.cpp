@@ -84,8 +84,7 @@ int sampledTexel(const kern::EnvmapView& view, const kern::MaRandom4& r) { retur
 // `samples` texels drawn by `draw` (by default the kernels' sampleEnvmap) with Philox
 // keyed (seedLo, seedHi): none of probability 0, and a χ² test against p at `level`.
 void checkDrawnTexels(const kern::EnvmapView& view, const std::vector<double>& p, uint64_t samples, uint32_t seedLo,
-                      uint32_t seedHi, double level,
-                      const std::function<int(const kern::MaRandom4&)>& draw = {}) {
+                      uint32_t seedHi, double level, const std::function<int(const kern::MaRandom4&)>& draw = {}) {
   std::vector<uint64_t> counts(p.size(), 0);
   for (uint64_t i = 0; i < samples; ++i) {
     const kern::MaRandom4 r = kern::philoxDraw(seedLo, seedHi, 0, 0, uint32_t(i));
@@ -566,8 +565,8 @@ TEST_CASE(
       const kern::EnvmapView shareOne = pixelOptimalView(tables, point, 1.0f, false, atShareOne);
       double worst = 0;
       for (int c = 0; c < tables.pixelCells; ++c)
-        worst = std::max(worst, std::abs(double(kern::pixelCellProbability(product, c)) -
-                                         kern::pixelCellProbability(shareOne, c)));
+        worst = std::max(
+            worst, std::abs(double(kern::pixelCellProbability(product, c)) - kern::pixelCellProbability(shareOne, c)));
       CHECK(worst <= 8 / kGrid24);
     }
   }

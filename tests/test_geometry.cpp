@@ -219,7 +219,8 @@ TEST_CASE("the product technique from the pixel's cells is unbiased in frames of
     const std::string where = offAxisName(c);
     addSized(family, where + ": the product alone", expected, 64, 4, ++seed, [&](int spp, uint64_t sd) {
       StagePlan plan = singleStagePlan(scene, Method::Equal, spp);
-      for (int p = 0; p < scene.pixelCount(); ++p) plan.counts[3 * p] = plan.counts[3 * p + 1] = 0, plan.counts[3 * p + 2] = spp;
+      for (int p = 0; p < scene.pixelCount(); ++p)
+        plan.counts[3 * p] = plan.counts[3 * p + 1] = 0, plan.counts[3 * p + 2] = spp;
       return pixelMean(sweepSampler(scene, {Estimator::MultiSample, 0, 0})->run(plan, sd).rgb);
     });
     for (Estimator e : {Estimator::MultiSample, Estimator::OneSample})

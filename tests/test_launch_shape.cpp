@@ -34,8 +34,9 @@ int statSlotsOf(Method method, bool split) {
 }
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
-  return
-      [statSlots](int size) { return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0, 0)); };
+  return [statSlots](int size) {
+    return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0, 0));
+  };
 }
 
 bool hasFp64(const cl::Device& device) {

@@ -252,8 +252,10 @@ TEST_CASE("the product technique with split lobes is refused: 4 techniques", "[p
   CHECK_THROWS_WITH(makeScene(o), Catch::Matchers::Contains("--product with --split-brdf: not implemented"));
 }
 
-TEST_CASE("on per-pixel normals and views the product comes from the optimal pdf per pixel's cells, and its tables are refused",
-          "[product][geometry][bad-input]") {
+TEST_CASE(
+    "on per-pixel normals and views the product comes from the optimal pdf per pixel's cells, and its tables are "
+    "refused",
+    "[product][geometry][bad-input]") {
   CHECK_THROWS_WITH(makeScene(productSphere("plain")),
                     Catch::Matchers::Contains("--product with --envmap-pdf plain and per-pixel normals or views: not "
                                               "implemented"));
@@ -330,9 +332,10 @@ TEST_CASE("compare --product on per-pixel geometry runs the optimal pdf per pixe
   CHECK(plain.output.find("--product with --envmap-pdfs plain on per-pixel normals or views: not implemented") !=
         std::string::npos);
   CHECK_FALSE(fs::exists(dir.path / "plain"));
-  auto render = runMisalloc(fmt::format("render --scene sphere --envmap sun --size 16x16 --product --envmap-pdf plain "
-                                        "--spp 8 --out {}",
-                                        (dir.path / "render.exr").string()));
+  auto render =
+      runMisalloc(fmt::format("render --scene sphere --envmap sun --size 16x16 --product --envmap-pdf plain "
+                              "--spp 8 --out {}",
+                              (dir.path / "render.exr").string()));
   CHECK(render.exitCode == 2);
   CHECK(render.output.find("--product with --envmap-pdf plain and per-pixel normals or views") != std::string::npos);
   CHECK_FALSE(fs::exists(dir.path / "render.exr"));

@@ -130,8 +130,9 @@ TEST_CASE("bad --scene specs and views are refused, naming the option", "[scenes
   CHECK_THROWS_WITH(makeScene(o), Catch::Contains("not implemented"));
   o.envmapPdf = {};
   o.product = true;
-  CHECK_THROWS_WITH(makeScene(o),
-                    Catch::Contains("--product with --envmap-pdf plain and per-pixel normals or views: not implemented"));
+  CHECK_THROWS_WITH(
+      makeScene(o),
+      Catch::Contains("--product with --envmap-pdf plain and per-pixel normals or views: not implemented"));
 }
 
 TEST_CASE("background pixels take no samples and count in no error, whatever the method", "[scenes][adaptive]") {

@@ -31,15 +31,13 @@ TEST_CASE("the image's predicted gain sums the pixels' variances and costs", "[i
   // Every pixel's variance halved at equal cost: twice the efficiency.
   CHECK(*predictedImageGain(allocationOf({{4, 2}, {1, 0.5f}}, {half, half}), same, all) == Approx(2.0));
   // Sums, not a mean of ratios: the noisy pixel decides. (100 + 1) / (100 + 0.1).
-  CHECK(*predictedImageGain(allocationOf({{100, 100}, {1, 0.1f}}, {half, half}), same, all) ==
-        Approx(101.0 / 100.1));
+  CHECK(*predictedImageGain(allocationOf({{100, 100}, {1, 0.1f}}, {half, half}), same, all) == Approx(101.0 / 100.1));
   // The costs of the image's samples: every pixel moved to the technique of cost 3 pays
   // 3 per sample against equal counts' 2.
   CHECK(*predictedImageGain(allocationOf({{4, 2}, {1, 0.5f}}, {{0, 1}, {0, 1}}), {1.0, 3.0}, all) ==
         Approx(2.0 * 2.0 / 3.0));
   // The background takes no samples: neither its variances nor its costs count.
-  CHECK(*predictedImageGain(allocationOf({{4, 2}, {1e6f, 1}}, {half, {0, 1}}), {1.0, 3.0}, {1, 0}) ==
-        Approx(2.0));
+  CHECK(*predictedImageGain(allocationOf({{4, 2}, {1e6f, 1}}, {half, {0, 1}}), {1.0, 3.0}, {1, 0}) == Approx(2.0));
   // A pixel without held-out variances adds none, but it still takes its samples.
   CHECK(*predictedImageGain(allocationOf({{4, 2}, {NAN, NAN}}, {half, {0, 1}}), {1.0, 3.0}, all) ==
         Approx(2.0 * 4.0 / 5.0));

@@ -454,9 +454,12 @@ void selectPooledPixel(const SearchSetup& setup, const PooledSelection& pooling,
 }
 
 SelectionArrays selectionArrays(int pixels, int m) {
-  return SelectionArrays{std::vector<float>(std::size_t(pixels) * m), std::vector<int>(pixels),
-                         std::vector<unsigned>(pixels), std::vector<unsigned char>(pixels, 0),
-                         std::vector<float>(pixels, 1.0f), std::vector<float>(2 * std::size_t(pixels), NAN)};
+  return SelectionArrays{std::vector<float>(std::size_t(pixels) * m),
+                         std::vector<int>(pixels),
+                         std::vector<unsigned>(pixels),
+                         std::vector<unsigned char>(pixels, 0),
+                         std::vector<float>(pixels, 1.0f),
+                         std::vector<float>(2 * std::size_t(pixels), NAN)};
 }
 
 }  // namespace
@@ -610,7 +613,8 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
     bindKernelArgs(poolKernel_, scores_, scales_, alphaOut, selectedOut, fallbacksOut, surfaces_,
                    cl_int(pooling->width), cl_int(pooling->height), cl_int(pooling->radius), gridLanes, gridCost,
                    cl_int(grid.size()), cl_int(lanes.paddedSize), cl_int(nearestEqual(grid)),
-                   cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut, heldOut);
+                   cl_float(pooling->minGain), alphaFinal, selectedFinal, fallbacksFinal, skippedOut, ratioOut,
+                   heldOut);
     cl::Event pooled;
     device_.queue.enqueueNDRangeKernel(
         poolKernel_, cl::NullRange,

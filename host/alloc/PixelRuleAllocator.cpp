@@ -35,8 +35,8 @@ StageAllocation PixelRuleAllocator::allocate(StageStatistics& stages, const std:
   poolNeighbourhood(stats, scene.grid.width, scene.grid.height, slots, poolRadius_, scene.surfaces);
   const std::vector<float> stored = rule_ == PixelRule::Linear ? stages.storedSamples() : std::vector<float>{};
   const int taken = stages.samplesTaken();
-  StageAllocation out{std::vector<Allocation>(pixels), std::vector<float>(pixels, 1.0f),
-                      std::vector<unsigned char>(pixels, 0), {}};
+  StageAllocation out{
+      std::vector<Allocation>(pixels), std::vector<float>(pixels, 1.0f), std::vector<unsigned char>(pixels, 0), {}};
 #pragma omp parallel for schedule(dynamic, 256)
   for (int p = 0; p < pixels; ++p) {
     PixelStats pixelStats = decodePixelStats(stats.data() + size_t(p) * slots, config.statsMask, M);

@@ -29,8 +29,10 @@ bool keepsEqualCounts(const std::optional<double>& predictedGain, double gainBel
 }
 
 StageAllocation equalStageAllocation(int pixels, int techniqueCount) {
-  return {std::vector<Allocation>(pixels, allocateEqual(techniqueCount)), std::vector<float>(pixels, 1.0f),
-          std::vector<unsigned char>(pixels, 1), {}};
+  return {std::vector<Allocation>(pixels, allocateEqual(techniqueCount)),
+          std::vector<float>(pixels, 1.0f),
+          std::vector<unsigned char>(pixels, 1),
+          {}};
 }
 
 }  // namespace misalloc

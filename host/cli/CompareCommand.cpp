@@ -93,7 +93,7 @@ int runCompare(CompareArgs& args) {
   CompareOptions& compare = args.compare;
   // The probe below is a plain scene (compare takes its pdfs from --envmap-pdfs), but on
   // per-pixel geometry the product exists only with the optimal pdf per pixel's cells.
-  if (args.scene.parsed().productFromPixelCells()) args.scene.envmapPdf = "optimal-pixel";
+  if (args.scene.parsed().productNeedsPixelCells()) args.scene.envmapPdf = "optimal-pixel";
   if (args.suite) {
     for (const char* sceneOption : {"--envmap", "--grid", "--envmap-sampler", "--split-brdf"})
       if (args.command->count(sceneOption) > 0)
@@ -119,10 +119,10 @@ int runCompare(CompareArgs& args) {
   // where the product technique comes from its cells.
   const SceneOptions& first = compare.cases.front().scene;
   if (first.perPixelGeometry() && args.command->count("--envmap-pdfs") == 0 && !first.splitBrdf)
-    args.envmapPdfs = first.productFromPixelCells() ? "optimal-pixel" : "plain,optimal-pixel";
+    args.envmapPdfs = first.productNeedsPixelCells() ? "optimal-pixel" : "plain,optimal-pixel";
   const std::vector<EnvmapPdf> pdfs = parseEnvmapPdfList(args.envmapPdfs);
   for (const EnvmapPdf& pdf : pdfs)
-    if (first.productFromPixelCells() && !pdf.pixelOptimal())
+    if (first.productNeedsPixelCells() && !pdf.pixelOptimal())
       throw InputError(fmt::format(
           "--product with --envmap-pdfs {} on per-pixel normals or views: not implemented; only optimal-pixel "
           "builds the product there, from each pixel's cells",

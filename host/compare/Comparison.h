@@ -66,8 +66,8 @@ struct RunRecord {
   double statisticsBytesPerPixel = 0;
   std::optional<double> predictedGain;  // exact: the pilot's whole-image prediction (Rendering)
   bool keptEqualCounts = false;         // exact: the whole-image rule kept equal counts
-  std::vector<StageTiming> stages;  // kernel times, predicted and measured
-  std::string costSource;           // adaptive methods: their cost model's (costSourceName)
+  std::vector<StageTiming> stages;      // kernel times, predicted and measured
+  std::string costSource;               // adaptive methods: their cost model's (costSourceName)
 
   // 1/(MSE × time): what a method buys per second.
   double efficiency() const { return 1.0 / (mse * wallSeconds); }

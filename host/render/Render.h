@@ -37,8 +37,8 @@ struct AdaptiveOptions {
   double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
   // exact: the whole-image rule's least predicted gain at equal time (alloc/WholeImageRule.h)
   double imageGainBelow = kDefaultImageGainBelow;
-  std::vector<double> costs;    // c_k per sample, one per technique (--cost); empty: the sampler's CostModel
-  bool measureCosts = false;    // --cost measure: the caller calibrates the samplers again (render/CostCache.h)
+  std::vector<double> costs;  // c_k per sample, one per technique (--cost); empty: the sampler's CostModel
+  bool measureCosts = false;  // --cost measure: the caller calibrates the samplers again (render/CostCache.h)
   ZeroWeightRule linearRule = ZeroWeightRule::MinSampleVariance;
   int gridSize = kDefaultGridSize;  // exact: U weight combinations
   GridRule gridRule = GridRule::MinCostVariance;

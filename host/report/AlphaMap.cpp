@@ -24,7 +24,7 @@ AlphaMapFiles encodeAlphaMaps(const Scene& scene, const Rendering& rendering) {
   for (size_t p = 0; p < size_t(W) * H; ++p) {
     for (int k = 0; k < M; ++k) planes[k][p] = float(rendering.alpha[p * M + k]);
     if (!rendering.image.covers(p)) continue;  // the background took no samples: black
-    double share[3] = {0, 0, 0};  // red, green, blue
+    double share[3] = {0, 0, 0};               // red, green, blue
     for (int k = 0; k < M; ++k) {
       const int role = scene.options.techniqueRole(k);
       share[role == kern::ROLE_ENVMAP ? 2 : role == kern::ROLE_PRODUCT ? 1 : 0] += rendering.alpha[p * M + k];

@@ -149,7 +149,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
         const int C = columns.count();
         samples_[kern::storedSampleIndex(pixel, i, 0, config_.sampleCapacity, C)] =
             float(kern::storedColumn(s, columns.shareColumns));
-        samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, C)] = kern::storedSampleValue(int(config.statsMask), s);
+        samples_[kern::storedSampleIndex(pixel, i, 1, config_.sampleCapacity, C)] =
+            kern::storedSampleValue(int(config.statsMask), s);
         for (int l = 0; l < C; ++l)
           samples_[kern::storedSampleIndex(pixel, i, 2 + l, config_.sampleCapacity, C)] =
               kern::storedPdf(s, columns.shareColumns, l);

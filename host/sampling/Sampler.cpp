@@ -58,7 +58,8 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       "-DMA_CDF_STEPS_COL={} -DMA_ANALYTIC_RADIANCE={} -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
       "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_PRODUCT_TABLES={} -DMA_PRODUCT_BLOCK_LOG2={} "
-      "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_PRODUCT_CELLS={} -DMA_PIXEL_CELLS={} -DMA_PIXEL_CDF_STEPS={} -DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} "
+      "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_PRODUCT_CELLS={} -DMA_PIXEL_CELLS={} -DMA_PIXEL_CDF_STEPS={} "
+      "-DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} "
       "-DMA_SPLIT_LOAD64={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent >= 0 ? 1 : 0, t.bankShares, t.blockLog2,
@@ -66,8 +67,7 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       config.risCandidates, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
       sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0, scene.productTables.tables,
       scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, scene.productTables.pixelCells ? 1 : 0,
-      t.pixelCells, t.pixelCdfSteps, localSize,
-      pixelLanes, pixelLanes > 0 ? 1 : 0);
+      t.pixelCells, t.pixelCdfSteps, localSize, pixelLanes, pixelLanes > 0 ? 1 : 0);
 }
 
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes) {
@@ -106,10 +106,10 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const LaunchShape shape = chooseLocalSize(
       limits,
       [&](int size) {
-        return sampleKernelLocalBytes(size, statSlots(), doubleSums_,
-                                      kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(),
-                                                          scene.productTables.tables > 0, scene.tables.pixelCells,
-                                                          scene.productTables.pixelCells));
+        return sampleKernelLocalBytes(
+            size, statSlots(), doubleSums_,
+            kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
+                                scene.tables.pixelCells, scene.productTables.pixelCells));
       },
       localSize);
   localSize_ = shape.localSize;

@@ -43,7 +43,7 @@ struct SceneOptions {
   bool perPixelGeometry() const;
   // --product on per-pixel geometry: it comes from the optimal pdf per pixel's cells,
   // the only pdf that allows it there.
-  bool productFromPixelCells() const { return product && perPixelGeometry(); }
+  bool productNeedsPixelCells() const { return product && perPixelGeometry(); }
 
   // What technique k samples: kern::ROLE_ENVMAP, ROLE_BRDF, ... (kernels/estimator.h).
   int techniqueRole(int technique) const;
