@@ -105,8 +105,9 @@ MA_FN float pixelCdfAt(EnvmapView env, int c) { return ma_as_float((ma_uint)env.
 // that searchPixelCdf returns c.
 MA_FN float pixelCellProbability(EnvmapView env, int c) { return pixelCdfAt(env, c + 1) - pixelCdfAt(env, c); }
 
-// The most cells the pixel's CDF may have: searchPixelCdf takes at most 8 steps.
-#define MA_MAX_PIXEL_CELLS 256
+// The most cells the pixel's CDF may have: 64 × 32 (kMaxPixelCellsAcross), which
+// searchPixelCdf reaches in 11 of its 16 steps.
+#define MA_MAX_PIXEL_CELLS 2048
 
 // A fixed-step binary search's steps written out as straight code, STEP(i) for each i:
 // a loop left in the sample loop, unrolled or not, keeps PoCL's sample loop scalar
@@ -129,7 +130,7 @@ MA_FN void pixelCdfStep(EnvmapView env, int stepIndex, float u, int* base, int* 
 MA_FN int searchPixelCdf(EnvmapView env, float u) {
   int base = 0, n = env.pixelCells;
 #define MA_PIXEL_CDF_STEP(i) pixelCdfStep(env, i, u, &base, &n);
-  MA_SEARCH_STEPS_8(MA_PIXEL_CDF_STEP)
+  MA_SEARCH_STEPS_16(MA_PIXEL_CDF_STEP)
 #undef MA_PIXEL_CDF_STEP
   return base;
 }

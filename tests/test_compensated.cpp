@@ -18,6 +18,7 @@
 #include "TestDevice.h"
 #include "TestSize.h"
 #include "compare/EnvmapPdfComparison.h"
+#include "compare/Suite.h"
 #include "render/Reference.h"
 #include "render/Render.h"
 #include "render/RunChecks.h"
@@ -68,7 +69,8 @@ const std::vector<std::pair<Method, Estimator>> kMethodsWithBrdfSampling = {
 
 }  // namespace
 
-TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C and optimal", "[compensated]") {
+TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C, optimal and optimal-pixel:N",
+          "[compensated]") {
   CHECK_FALSE(parseEnvmapPdf("plain").compensated());
   CHECK(parseEnvmapPdf("plain").plain());
   CHECK(parseEnvmapPdf("optimal").optimal());
@@ -79,9 +81,30 @@ TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C and 
   CHECK(parseEnvmapPdf("compensated:1").envmapFraction == 1);
   CHECK(envmapPdfName(parseEnvmapPdf("compensated")) == "compensated:0.5");
   CHECK(envmapPdfName(parseEnvmapPdf("plain")) == "plain");
-  for (const char* bad :
-       {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:", "optimal:0.5", "Plain"})
+  CHECK(parseEnvmapPdf("optimal-pixel").cellsAcross == misalloc::kDefaultPixelCellsAcross);
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel")) == "optimal-pixel");
+  CHECK(parseEnvmapPdf("optimal-pixel:16").pixelOptimal());
+  CHECK(parseEnvmapPdf("optimal-pixel:16").cellsAcross == 16);
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:4")) == "optimal-pixel:4");
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:64")) == "optimal-pixel:64");
+  CHECK(envmapPdfName(parseEnvmapPdf(fmt::format("optimal-pixel:{}", misalloc::kDefaultPixelCellsAcross))) ==
+        "optimal-pixel");
+  for (const char* bad : {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:",
+                          "optimal:0.5", "Plain", "optimal-pixel:", "optimal-pixel:2", "optimal-pixel:12",
+                          "optimal-pixel:128", "optimal-pixel:16x8", "optimal-pixel:-16", "optimal-pixel:0"})
     CHECK_THROWS_AS(parseEnvmapPdf(bad), InputError);
+}
+
+TEST_CASE("compare names the optimal pdf per pixel's cells where they are not the default's",
+          "[compensated][compare]") {
+  // Each case's runs go to a folder of its label: two cell counts must not share one.
+  SceneOptions o;
+  o.envmap = "forest_slope";
+  o.shape = "spheres";
+  o.envmapPdf = parseEnvmapPdf("optimal-pixel");
+  CHECK(misalloc::caseLabel(o) == "forest_slope-spheres-optimal-pixel");
+  o.envmapPdf = parseEnvmapPdf("optimal-pixel:16");
+  CHECK(misalloc::caseLabel(o) == "forest_slope-spheres-optimal-pixel-16");
 }
 
 TEST_CASE("L̄ of a cos^K map is 1/(2(K+1)) and the compensated pdf drops every texel at or below it", "[compensated]") {
@@ -288,6 +311,18 @@ TEST_CASE("every method is unbiased with the optimal pdf per pixel against [HS14
                expected, 60, 60, ++seed, [&](int spp, uint64_t sd) { return imageMean(scene, m, e, spp, sd); });
     }
   }
+  // Cells other than the default's: the fewest, and the most the search reaches on this
+  // 512-texel map's 64 × 32.
+  const Case& c = cases[0];
+  const double expected = closedForm(c.rhoD, 1 - c.rhoD, c.n, c.K);
+  for (const char* pdf : {"optimal-pixel:4", "optimal-pixel:64"}) {
+    Scene scene =
+        compensatedScene(fmt::format("cosk:{}", c.K), fmt::format("uniform:{},{},{}", c.rhoD, 1 - c.rhoD, c.n), pdf);
+    REQUIRE(scene.tables.pixelCells == scene.tables.pdf.cellsAcross * scene.tables.pdf.cellsAcross / 2);
+    for (Method m : {Method::Equal, Method::Exact})
+      addSized(family, fmt::format("rhoD {} n {} K {} {} {}", c.rhoD, c.n, c.K, pdf, methodName(m)), expected, 60, 60,
+               ++seed, [&](int spp, uint64_t sd) { return imageMean(scene, m, Estimator::MultiSample, spp, sd); });
+  }
   checkFamily(family);
 }
 
@@ -312,7 +347,30 @@ TEST_CASE("the optimal pdf per pixel refuses envmap sampling alone and split BRD
   const nlohmann::json pdf = nlohmann::json::parse(in)["scene"]["envmap_pdf"];
   CHECK(pdf["used"] == "optimal-pixel");
   CHECK(pdf["fallback_to_plain"] == false);
-  CHECK(pdf["pixel_cells"]["cells"].get<int>() > 1);
+  CHECK(pdf["pixel_cells"]["across"] == misalloc::kDefaultPixelCellsAcross);
+  CHECK(pdf["pixel_cells"]["cells"] == misalloc::kDefaultPixelCellsAcross * misalloc::kDefaultPixelCellsAcross / 2);
+
+  // Its cells asked for, and refused where the search could not reach them or a cell
+  // would not be a block of texels; nothing written then.
+  std::filesystem::remove(dir.path / "r.json");
+  auto sixteen = runMisalloc(fmt::format(
+      "render --scene sphere --size 16x16 --spp 8 --method equal --envmap-pdf optimal-pixel:16 {}", outputs));
+  REQUIRE(sixteen.exitCode == 0);
+  std::ifstream sixteenIn(dir.path / "r.json");
+  const nlohmann::json pdf16 = nlohmann::json::parse(sixteenIn)["scene"]["envmap_pdf"];
+  CHECK(pdf16["requested"] == "optimal-pixel:16");
+  CHECK(pdf16["used"] == "optimal-pixel:16");
+  CHECK(pdf16["pixel_cells"]["across"] == 16);
+  CHECK(pdf16["pixel_cells"]["cells"] == 128);
+  for (const char* bad : {"optimal-pixel:24", "optimal-pixel:128"}) {
+    TempDir badDir("optimal-pixel-bad");
+    auto refused = runMisalloc(fmt::format("render --scene sphere --size 16x16 --spp 8 --envmap-pdf {} --out {}", bad,
+                                           (badDir.path / "r.exr").string()));
+    INFO(refused.output);
+    CHECK(refused.exitCode != 0);
+    CHECK(refused.output.find("N, the cells across the map, must be a power of two from 4 to 64") != std::string::npos);
+    CHECK(std::filesystem::is_empty(badDir.path));
+  }
 
   auto black = runMisalloc(fmt::format(
       "render --size 8x8 --spp 8 --method equal --envmap constant:0 --envmap-pdf optimal-pixel {}", outputs));

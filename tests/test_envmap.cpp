@@ -578,7 +578,9 @@ TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables
   // nearest it (kernels/stats.h's share columns), which pixelSharePdfs evaluates from
   // scales kept beside the stage's own table. At every texel, each must be the pdf of the
   // table that a stage of that share builds, up to the rounding of that table's CDF
-  // entries to the uniform's grid and the order of its sums.
+  // entries to the uniform's grid and the order of its sums: a cell's probability within
+  // 8 steps of the grid, as the product's test above bounds it (32 × 16 cells, 32 to a chunk, came
+  // within 4.1 steps; 16 × 8 within 4).
   for (const auto& [name, map] : testMaps()) {
     EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
     if (tables.pixelCells == 0) continue;  // the black map's plain tables
@@ -597,7 +599,7 @@ TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables
           float pdfs[MA_MAX_BANK_SHARES];
           kern::pixelSharePdfs(stage, point.brdf, point.normal, point.mirror, t, sinTheta, pdfs);
           const double expected = kern::envmapPdfOfTexel(built, kern::texelProbability(built, t), sinTheta);
-          const double slack = 1e-4 * expected + perProbability * tables.texels[4 * t + 3] * 4 * kFloatRounding;
+          const double slack = 1e-4 * expected + perProbability * tables.texels[4 * t + 3] * 8 / kGrid24;
           mismatches += !(std::abs(pdfs[share] - expected) <= slack);
           positive += expected > 0;
         }
@@ -610,20 +612,25 @@ TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables
 
 TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reaches, on any map's shape",
           "[envmap][optimal]") {
-  // A map taller than wide would otherwise give 16 × 64 cells, beyond searchPixelCdf's
-  // 8 steps: the last cells could never be drawn, though the pdf counts them.
-  for (auto [width, height] : {std::pair{1024, 512}, std::pair{16, 1024}, std::pair{1, 4096}, std::pair{4096, 4096}}) {
-    const int log2 = misalloc::pixelCellLog2(width, height);
-    const int64_t across = (width + (1 << log2) - 1) >> log2, down = (height + (1 << log2) - 1) >> log2;
-    INFO(width << "x" << height << ": 2^" << log2 << " texels a side");
-    CHECK(log2 >= 1);
-    CHECK(across <= misalloc::kPixelCellsAcross);
-    CHECK(across * down <= MA_MAX_PIXEL_CELLS);
-  }
-  CHECK(misalloc::pixelCellLog2(1024, 512) == 6);  // 16 × 8 cells
-  // A tall map's texels are drawn with the probabilities the pdf gives them: 2 × 128
-  // cells of 8 × 8 texels, the most the search reaches.
-  const Envmap tall = greyMap(16, 1024, [](int col, int row) { return float(1 + (col + 3 * row) % 7); });
+  // A map taller than wide would otherwise give more cells than searchPixelCdf's steps
+  // reach: the last cells could never be drawn, though the pdf counts them.
+  for (int cellsAcross = misalloc::kMinPixelCellsAcross; cellsAcross <= misalloc::kMaxPixelCellsAcross;
+       cellsAcross *= 2)
+    for (auto [width, height] :
+         {std::pair{1024, 512}, std::pair{16, 1024}, std::pair{1, 4096}, std::pair{4096, 4096}}) {
+      const int log2 = misalloc::pixelCellLog2(width, height, cellsAcross);
+      const int64_t across = (width + (1 << log2) - 1) >> log2, down = (height + (1 << log2) - 1) >> log2;
+      INFO(width << "x" << height << ", " << cellsAcross << " across: 2^" << log2 << " texels a side");
+      CHECK(log2 >= 1);
+      CHECK(across <= cellsAcross);
+      CHECK(across * down <= MA_MAX_PIXEL_CELLS);
+    }
+  CHECK(misalloc::pixelCellLog2(1024, 512, 16) == 6);                                  // 16 × 8 cells
+  CHECK(misalloc::pixelCellLog2(1024, 512, misalloc::kDefaultPixelCellsAcross) == 5);  // 32 × 16
+  CHECK(misalloc::pixelCellLog2(1024, 512, misalloc::kMaxPixelCellsAcross) == 4);      // 64 × 32
+  // A tall map's texels are drawn with the probabilities the pdf gives them: 8 × 256
+  // cells of 4 × 4 texels, the most the search reaches.
+  const Envmap tall = greyMap(32, 1024, [](int col, int row) { return float(1 + (col + 3 * row) % 7); });
   EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(tall);
   REQUIRE(tables.pixelCells == MA_MAX_PIXEL_CELLS);
   kern::EnvmapView view = viewOf(tables);
@@ -645,7 +652,7 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
   // lobe of the cell's own spread at the cells' spacing allows (√12 spreads apart: 0.35–2.0
   // on a square grid). The lobe's value at the centres misses a narrow lobe's mass by
   // orders of magnitude, either way (0 or 200× at n = 10⁴): the case this exists for.
-  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", 1024));
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", 1024), 16);
   REQUIRE(tables.pixelCells == 16 * 8);
   auto cell = [&](int c) { return tables.blockProbs.data() + MA_CELL_FLOATS * c; };
   auto centre = [&](int c) { return kern::cellCentre(cell(c)); };
@@ -698,7 +705,7 @@ TEST_CASE("the optimal pdf per pixel weighs cos θ by its mean over a cell, the 
   // the centre errs by 2.1–3.5 % per normal, mostly where a cell straddles the horizon;
   // the mean by about 2 %, where the cosine curves within a cell wholly above it.
   const int width = 256, height = 128;
-  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", width));
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", width), 16);
   REQUIRE(tables.pixelCells == 16 * 8);
   const int side = 1 << tables.blockLog2;
   double totalMean = 0, totalCentre = 0;

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <filesystem>
+#include <string>
 
 namespace misalloc {
 
@@ -20,6 +21,8 @@ std::string caseLabel(const SceneOptions& scene) {
   if (scene.envmapPdf.compensated()) name += "-comp" + envmapPdfName(scene.envmapPdf).substr(sizeof("compensated"));
   if (scene.envmapPdf.optimal()) name += "-optimal";
   if (scene.envmapPdf.pixelOptimal()) name += "-optimal-pixel";
+  if (scene.envmapPdf.pixelOptimal() && scene.envmapPdf.cellsAcross != kDefaultPixelCellsAcross)
+    name += "-" + std::to_string(scene.envmapPdf.cellsAcross);
   return name;
 }
 

@@ -5,29 +5,51 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <optional>
 
 #include "Constants.h"
 #include "Error.h"
 
 namespace misalloc {
 
+namespace {
+
+// The number after "name:" in spec, whole; nullopt if there is none or more follows it.
+template <typename T>
+std::optional<T> parameterOf(const std::string& spec, const std::string& name) {
+  const char* first = spec.data() + name.size() + 1;
+  const char* last = spec.data() + spec.size();
+  T value{};
+  auto [stop, error] = std::from_chars(first, last, value);
+  if (error == std::errc() && stop == last) return value;
+  return std::nullopt;
+}
+
+bool hasParameter(const std::string& spec, const std::string& name) { return spec.rfind(name + ":", 0) == 0; }
+
+}  // namespace
+
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
-  const std::string compensated = "compensated";
+  const std::string compensated = "compensated", pixelOptimal = "optimal-pixel";
   if (spec == "plain") return {};
   if (spec == "optimal") return {EnvmapPdf::Kind::Optimal, 0.5};
-  if (spec == "optimal-pixel") return {EnvmapPdf::Kind::PixelOptimal, 0.5};
+  if (spec == pixelOptimal) return {EnvmapPdf::Kind::PixelOptimal, 0.5};
   if (spec == compensated) return {EnvmapPdf::Kind::Compensated, 0.5};
-  if (spec.rfind(compensated + ":", 0) == 0) {
-    const char* first = spec.data() + compensated.size() + 1;
-    const char* last = spec.data() + spec.size();
-    double c = 0;
-    auto [stop, error] = std::from_chars(first, last, c);
-    if (error == std::errc() && stop == last && c > 0 && c <= 1) return {EnvmapPdf::Kind::Compensated, c};
+  if (hasParameter(spec, compensated)) {
+    const std::optional<double> c = parameterOf<double>(spec, compensated);
+    if (c && *c > 0 && *c <= 1) return {EnvmapPdf::Kind::Compensated, *c};
     throw InputError(
         fmt::format("{} {}: C, the envmap technique's share of the samples, must lie in (0, 1]", option, spec));
   }
-  throw InputError(
-      fmt::format("{} '{}': expected plain, compensated, compensated:C, optimal or optimal-pixel", option, spec));
+  if (hasParameter(spec, pixelOptimal)) {
+    const std::optional<int> n = parameterOf<int>(spec, pixelOptimal);
+    if (n && *n >= kMinPixelCellsAcross && *n <= kMaxPixelCellsAcross && (*n & (*n - 1)) == 0)
+      return {EnvmapPdf::Kind::PixelOptimal, 0.5, *n};
+    throw InputError(fmt::format("{} {}: N, the cells across the map, must be a power of two from {} to {}", option,
+                                 spec, kMinPixelCellsAcross, kMaxPixelCellsAcross));
+  }
+  throw InputError(fmt::format(
+      "{} '{}': expected plain, compensated, compensated:C, optimal, optimal-pixel or optimal-pixel:N", option, spec));
 }
 
 std::string envmapPdfName(const EnvmapPdf& pdf) {
@@ -37,7 +59,8 @@ std::string envmapPdfName(const EnvmapPdf& pdf) {
     case EnvmapPdf::Kind::Optimal:
       return "optimal";
     case EnvmapPdf::Kind::PixelOptimal:
-      return "optimal-pixel";
+      return pdf.cellsAcross == kDefaultPixelCellsAcross ? "optimal-pixel"
+                                                         : fmt::format("optimal-pixel:{}", pdf.cellsAcross);
     case EnvmapPdf::Kind::Plain:
       break;
   }

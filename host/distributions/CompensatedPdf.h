@@ -11,6 +11,12 @@
 
 namespace misalloc {
 
+// The optimal pdf per pixel's cells across the map by default: 32 × 16 cells of 11.25°,
+// which beat 16 × 8 at equal time on real geometry (docs/results.md, "Finer cells for
+// the optimal pdf per pixel"); and the range a spec may ask for.
+constexpr int kDefaultPixelCellsAcross = 32;
+constexpr int kMinPixelCellsAcross = 4, kMaxPixelCellsAcross = 64;
+
 // The shape of the envmap technique's pdf (`--envmap-pdf`).
 // `Optimal` is [Kar19] eq. 9 for each pixel's own BRDF and envmap share (a bank of
 // tables, host/distributions/OptimalBank.h); `PixelOptimal` eq. 9 built by each pixel
@@ -20,6 +26,9 @@ struct EnvmapPdf {
   Kind kind = Kind::Plain;
   // C of [Kar19] eq. 14: the envmap technique's share of the samples, in (0, 1].
   double envmapFraction = 0.5;
+  // PixelOptimal: its cells across the map (half as many down), a power of two
+  // (distributions/EnvmapDistribution.h, pixelCellLog2).
+  int cellsAcross = kDefaultPixelCellsAcross;
 
   bool plain() const { return kind == Kind::Plain; }
   bool compensated() const { return kind == Kind::Compensated; }
@@ -27,11 +36,13 @@ struct EnvmapPdf {
   bool pixelOptimal() const { return kind == Kind::PixelOptimal; }
 };
 
-// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, "optimal" or "optimal-pixel"; throws
-// InputError, naming `option`, otherwise.
+// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, "optimal", "optimal-pixel" or
+// "optimal-pixel:N" with N cells across, a power of two in [kMinPixelCellsAcross,
+// kMaxPixelCellsAcross]; throws InputError, naming `option`, otherwise.
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option = "--envmap-pdf");
 
-// "plain", "compensated:C", "optimal" or "optimal-pixel", which parseEnvmapPdf reads back.
+// "plain", "compensated:C", "optimal", "optimal-pixel" (the default cells) or
+// "optimal-pixel:N", which parseEnvmapPdf reads back.
 std::string envmapPdfName(const EnvmapPdf& pdf);
 
 // L̄ of [Kar19] eq. 14: the luminance of a W×H lat-long map (row-major, row 0 at the

@@ -277,19 +277,19 @@ EnvmapTables buildEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, cons
 
 namespace {
 
-// A pdf that draws blocks (`kind`): its tables before the blocks, the map's size, the
-// pdf and L̄; for a black map, the plain (uniform) tables it falls back to.
+// A pdf that draws blocks: its tables before the blocks, the map's size, the pdf and L̄;
+// for a black map, the plain (uniform) tables it falls back to.
 EnvmapTables blockDrawnTables(const Envmap& envmap, EnvmapSampler sampler, const PlainWeights& plain,
-                              EnvmapPdf::Kind kind) {
+                              const EnvmapPdf& pdf) {
   if (!(plain.total > 0)) {
     EnvmapTables fallback = buildEnvmapTables(envmap, sampler);
-    fallback.requestedPdf = {kind};
+    fallback.requestedPdf = pdf;
     return fallback;
   }
   EnvmapTables tables;
   tables.width = envmap.image.width;
   tables.height = envmap.image.height;
-  tables.requestedPdf = tables.pdf = {kind};
+  tables.requestedPdf = tables.pdf = pdf;
   tables.meanLuminance = solidAngleMeanLuminance(plain.luminance, tables.width, tables.height);
   return tables;
 }
@@ -304,7 +304,7 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   const auto start = std::chrono::steady_clock::now();
   const PlainWeights plain = plainWeightsOf(image);
   const std::vector<double>& weights = plain.weights;
-  EnvmapTables tables = blockDrawnTables(envmap, sampler, plain, EnvmapPdf::Kind::Optimal);
+  EnvmapTables tables = blockDrawnTables(envmap, sampler, plain, {EnvmapPdf::Kind::Optimal});
   if (!(plain.total > 0)) return tables;
   tables.bankShares = options.shares;
   tables.blockLog2 = options.blockLog2;
@@ -352,7 +352,7 @@ EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sample
   return tables;
 }
 
-int pixelCellLog2(int width, int height) {
+int pixelCellLog2(int width, int height, int cellsAcross) {
   // At least 2 × 2 texels: sampleTexelInBlock draws a slot by a shift of 32 − 2L bits.
   // At most MA_MAX_PIXEL_CELLS cells, which searchPixelCdf's steps reach, also on a map
   // taller than the usual 2:1.
@@ -360,7 +360,7 @@ int pixelCellLog2(int width, int height) {
     return int64_t((width + (1 << log2) - 1) >> log2) * ((height + (1 << log2) - 1) >> log2);
   };
   int log2 = 1;
-  while (((width + (1 << log2) - 1) >> log2) > kPixelCellsAcross || cells(log2) > MA_MAX_PIXEL_CELLS) ++log2;
+  while (((width + (1 << log2) - 1) >> log2) > cellsAcross || cells(log2) > MA_MAX_PIXEL_CELLS) ++log2;
   return log2;
 }
 
@@ -391,19 +391,21 @@ std::vector<float> cellSpreads(int width, int height, int log2, const std::vecto
 
 }  // namespace
 
-EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap) {
+EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross) {
   requireValidSize(envmap);
   const RgbImage& image = envmap.image;
   const int width = image.width, height = image.height;
   const auto start = std::chrono::steady_clock::now();
   const PlainWeights plain = plainWeightsOf(image);
-  EnvmapTables tables = blockDrawnTables(envmap, EnvmapSampler::Alias, plain, EnvmapPdf::Kind::PixelOptimal);
+  EnvmapTables tables =
+      blockDrawnTables(envmap, EnvmapSampler::Alias, plain, {EnvmapPdf::Kind::PixelOptimal, 0.5, cellsAcross});
   if (!(plain.total > 0)) return tables;
-  const int log2 = tables.blockLog2 = pixelCellLog2(width, height);
+  const int log2 = tables.blockLog2 = pixelCellLog2(width, height, cellsAcross);
   // A slot of a cell's alias table takes 2L of a draw's 32 bits, the rest are its coin.
   if (log2 > kMaxPixelCellLog2)
-    throw InputError(fmt::format("envmap '{}' is {} texels wide: the optimal pdf per pixel takes at most {}",
-                                 envmap.description, width, kPixelCellsAcross << kMaxPixelCellLog2));
+    throw InputError(
+        fmt::format("envmap '{}' is {} texels wide: the optimal pdf per pixel with {} cells across takes at most {}",
+                    envmap.description, width, cellsAcross, cellsAcross << kMaxPixelCellLog2));
   const int side = 1 << log2;
   const int across = (width + side - 1) / side, down = (height + side - 1) / side;
   tables.pixelCells = across * down;

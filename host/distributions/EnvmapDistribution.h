@@ -99,19 +99,15 @@ void writeBlockSlotTables(const std::vector<double>& weights, int width, int hei
 EnvmapTables buildOptimalEnvmapTables(const Envmap& envmap, EnvmapSampler sampler, const BrdfGrid& grid,
                                       const std::array<float, 3>& mirror, const OptimalBankOptions& options = {});
 
-// The optimal pdf per pixel's cells span at most this many blocks across the map: 16 × 8
-// cells of 22.5°, whose table a pixel builds each stage (docs/results.md, "The optimal
-// pdf per pixel").
-constexpr int kPixelCellsAcross = 16;
-
-// log2 of the cells' side in texels for a map of width × height texels: at least 1, with
-// at most kPixelCellsAcross cells across and MA_MAX_PIXEL_CELLS in all.
-int pixelCellLog2(int width, int height);
+// log2 of the optimal pdf per pixel's cells' side in texels for a map of width × height
+// texels: at least 1, with at most `cellsAcross` cells across (EnvmapPdf::cellsAcross)
+// and MA_MAX_PIXEL_CELLS in all.
+int pixelCellLog2(int width, int height, int cellsAcross);
 constexpr int kMaxPixelCellLog2 = 12;
 
 // The optimal pdf per pixel's tables: cells of 2^pixelCellLog2 texels a side with their
 // centres, plain masses and solid angles; each cell's texels drawn by an alias table ∝
 // luminance × sin θ. A black map falls back to plain (uniform) tables.
-EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap);
+EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross = kDefaultPixelCellsAcross);
 
 }  // namespace misalloc

@@ -43,6 +43,7 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
   }
   if (tables.pixelCells > 0)
     pdf["pixel_cells"] = {{"cells", tables.pixelCells},
+                          {"across", (tables.width + (1 << tables.blockLog2) - 1) >> tables.blockLog2},
                           {"cell_texels", 1 << (2 * tables.blockLog2)},
                           {"table_bytes", (tables.aliasTable.size() + tables.blockProbs.size()) * 4},
                           {"build_seconds", tables.bankBuildSeconds}};

@@ -179,7 +179,7 @@ Scene makeScene(const SceneOptions& options) {
           "technique (M = 2)");
     // Its own sampler whatever --envmap-sampler says: a cell by the pixel's CDF, a texel
     // in it by the cell's alias table.
-    scene.tables = buildPixelOptimalEnvmapTables(scene.envmap);
+    scene.tables = buildPixelOptimalEnvmapTables(scene.envmap, options.envmapPdf.cellsAcross);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
