@@ -11,6 +11,7 @@
 #define MA_ENVMAP_H
 #include "common.h"
 #include "fastmath.h"
+#include "pixel_layout.h"
 #include "rng.h"
 
 // Row 0 is the zenith: texel (col, row) covers φ ∈ 2π[col, col+1)/W and
@@ -39,8 +40,8 @@ typedef struct {
   // and blocks: > 0, the blocks (cells) its CDF runs over; blockProbs then holds the
   // cells (MA_CELL_FLOATS each), not probabilities.
   int pixelCells;
-  MA_LOCAL const int*
-      pixelCdf;  // the pixel's CDF over its cells, entry c at pixelCdf[c · pixelCdfStride], as float bits
+  MA_LOCAL const int* pixelCdf;  // the pixel's CDF over its cells, entry p at pixelCdf[p · pixelCdfStride], as float
+                                 // bits, in the CDF's order (kernels/pixel_layout.h, cdfPositionOfCell)
   int pixelCdfStride;
   int pixelCdfSteps;  // ceil(log2(pixelCells)): searchPixelCdf's steps
 } EnvmapView;
@@ -98,12 +99,16 @@ MA_FN int bankEntryOf(EnvmapView env, float envmapFraction) {
   return env.brdfBin * env.bankShares + bankShareOf(env.bankShares, envmapFraction);
 }
 
-MA_FN float pixelCdfAt(EnvmapView env, int c) { return ma_as_float((ma_uint)env.pixelCdf[c * env.pixelCdfStride]); }
+MA_FN float pixelCdfAt(EnvmapView env, int p) { return ma_as_float((ma_uint)env.pixelCdf[p * env.pixelCdfStride]); }
 
-// The probability that the pixel's CDF draws cell c. Its entries lie on uniformFloat's
-// grid (kernels/pixel_optimal.h), so the difference is exact and is the probability
-// that searchPixelCdf returns c.
-MA_FN float pixelCellProbability(EnvmapView env, int c) { return pixelCdfAt(env, c + 1) - pixelCdfAt(env, c); }
+// The probability that the pixel's CDF draws cell c, at its position in the CDF's order
+// (kernels/pixel_layout.h, cdfPositionOfCell). The entries lie on uniformFloat's grid
+// (kernels/pixel_optimal.h), so the difference is exact and is the probability that
+// searchPixelCdf returns c.
+MA_FN float pixelCellProbability(EnvmapView env, int c) {
+  int p = cdfPositionOfCell(env.pixelCells, c);
+  return pixelCdfAt(env, p + 1) - pixelCdfAt(env, p);
+}
 
 // The most cells the pixel's CDF may have: 64 × 32 (kMaxPixelCellsAcross), which
 // searchPixelCdf reaches in 11 of its 16 steps.
@@ -125,14 +130,14 @@ MA_FN void pixelCdfStep(EnvmapView env, int stepIndex, float u, int* base, int* 
   *n = stepIndex < env.pixelCdfSteps ? *n - step : *n;
 }
 
-// The last cell c with cdf[c] ≤ u: searchCdf over the pixel's CDF. A cell of
-// probability 0 is never returned.
+// The cell at the last position p with cdf[p] ≤ u: searchCdf over the pixel's CDF. A
+// cell of probability 0 is never returned.
 MA_FN int searchPixelCdf(EnvmapView env, float u) {
   int base = 0, n = env.pixelCells;
 #define MA_PIXEL_CDF_STEP(i) pixelCdfStep(env, i, u, &base, &n);
   MA_SEARCH_STEPS_16(MA_PIXEL_CDF_STEP)
 #undef MA_PIXEL_CDF_STEP
-  return base;
+  return cellAtCdfPosition(env.pixelCells, base);
 }
 
 // The factor of texel t's probability that its block carries: the probability of

@@ -42,15 +42,16 @@ enum {
 #define MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) \
   (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
 // The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
-// scratch, pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS), then
-// the scales of the tables of the share columns' shares, 1 + 3 per share for at most 3
-// shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES), then with the product
-// technique from the same cells (productCells) its CDF's pixelCells + 1 entries.
+// scratch, 2 pixelCells entries and 5 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS,
+// MA_SPARE_ROW), then the scales of the tables of the share columns' shares, 1 + 3 per
+// share for at most 3 shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES),
+// then with the product technique from the same cells (productCells) its CDF's
+// pixelCells + 1 entries.
 #define MA_PIXEL_CHUNKS 16
 #define MA_PIXEL_SHARE_ROWS 10
 #define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                                                 \
   ((pixelCells) > 0                                                                                                 \
-       ? 2 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
+       ? 3 * (pixelCells) + 1 + 5 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
        : 0)
 #define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells) \
   (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells))
@@ -59,6 +60,25 @@ enum {
 // productCells: its CDF over the optimal pdf's cells.
 MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells, int productCells) {
   return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells);
+}
+
+// The order of the pixel's CDF over its cells: chunk by chunk, chunk j holding cells j,
+// j + K, j + 2K, ... (K = MA_PIXEL_CHUNKS). The build adds each chunk's masses and
+// writes each chunk's entries on its own (kernels/pixel_optimal.h), so that a pass can
+// give each lane of a work-group its own chunks: cells side by side then lie in chunks
+// side by side, and the lanes read them side by side in local memory.
+MA_FN int chunkOfCell(int c) { return c % MA_PIXEL_CHUNKS; }
+MA_FN int chunkLength(int count, int j) { return count / MA_PIXEL_CHUNKS + (j < count % MA_PIXEL_CHUNKS ? 1 : 0); }
+// The CDF position of chunk j's first cell.
+MA_FN int chunkStart(int count, int j) {
+  int shorter = count / MA_PIXEL_CHUNKS, longer = count % MA_PIXEL_CHUNKS;
+  return j * shorter + (j < longer ? j : longer);
+}
+MA_FN int cdfPositionOfCell(int count, int c) { return chunkStart(count, chunkOfCell(c)) + c / MA_PIXEL_CHUNKS; }
+MA_FN int cellAtCdfPosition(int count, int p) {
+  int shorter = count / MA_PIXEL_CHUNKS, longer = count % MA_PIXEL_CHUNKS, inLonger = longer * (shorter + 1);
+  int j = p < inLonger ? p / (shorter + 1) : longer + (shorter > 0 ? (p - inLonger) / shorter : 0);
+  return (p - chunkStart(count, j)) * MA_PIXEL_CHUNKS + j;
 }
 
 // The per-pixel buffers, pixel p's first element. Shading point words: the first

@@ -15,9 +15,10 @@
 // the bank (kernels/envmap.h, sampleEnvmapPixelCells). The pdf a sample is weighed with
 // is read from the same CDF, so the estimator is unbiased however coarse the cells are.
 //
-// The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them, so that a
-// work-group of one pixel (samplePixelStage) shares a pass among its lanes while its
-// sums keep the order that a single work-item and the C++ reference add them in.
+// The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them
+// (kernels/pixel_layout.h, chunkOfCell), so that a work-group of one pixel
+// (samplePixelStage) shares a pass among its lanes while its sums keep the order that a
+// single work-item and the C++ reference add them in: each chunk's cells in turn.
 //
 // A stage that stores its samples for the grid search of `exact` (kernels/stats.h, share
 // columns) also keeps the scales of the tables that stages of the shares C = 1/4, 1/2,
@@ -37,18 +38,28 @@
 #include "pixel_layout.h"
 
 // A cell's floats: its centre's direction x, y, z, its share of the plain pdf's mass,
-// its solid angle, and its spread as a lobe's exponent (cellLobe).
+// its solid angle, and its spread as a lobe's exponent (cellLobe). Each float of every
+// cell in turn (field f of cell c at cells[f · count + c]), so that lanes that take
+// cells side by side read each float side by side.
+enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 #define MA_CELL_FLOATS 6
 // The plain pdf's share of the pixel's table: the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
-// count + 1 entries, as float bits, which hold each cell's f until the last pass; then
-// each cell's p_ρ mass; then per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms.
-#define MA_CDF_ROW(c) (c)
+// count + 1 entries in its order (cdfPositionOfCell), as float bits; then, where one
+// work-item builds the table, each cell's p_ρ mass and its f in the cells' order (the
+// share columns read the p_ρ masses; samplePixelStage keeps both in registers); then
+// per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms; then a spare row per chunk,
+// which a lane with no cell of the chunk to write writes. (f in the CDF's rows, at its
+// cell's position, would save count rows, but pass 1's stores would no longer lie side
+// by side, and the compiler no longer vectorises it: 2.2× the time of the pilot stage.)
+#define MA_CDF_ROW(p) (p)
 #define MA_BRDF_ROW(count, c) ((count) + 1 + (c))
+#define MA_F_ROW(count, c) (2 * (count) + 1 + (c))
 enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
-#define MA_CHUNK_ROW(count, sum, j) (2 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
+#define MA_CHUNK_ROW(count, sum, j) (3 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
+#define MA_SPARE_ROW(count, j) MA_CHUNK_ROW(count, CHUNK_SUMS, j)
 // Then, for the share columns, 1/F and per share its table's (1−C)/B, optimal and plain
 // scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows.
 enum {
@@ -58,16 +69,29 @@ enum {
   SHARE_PLAIN = SHARE_OPTIMAL + MA_MAX_BANK_SHARES,
   SHARE_ROWS = SHARE_PLAIN + MA_MAX_BANK_SHARES
 };
-#define MA_SHARE_ROW(count, q) (2 * (count) + 1 + CHUNK_SUMS * MA_PIXEL_CHUNKS + (q))
+#define MA_SHARE_ROW(count, q) (MA_SPARE_ROW(count, MA_PIXEL_CHUNKS) + (q))
 // Then the product technique's CDF, count + 1 entries.
 #define MA_PRODUCT_CDF_ROW(count, c) (MA_SHARE_ROW(count, SHARE_ROWS) + (c))
 
 MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
 MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
 
-MA_FN int chunkBegin(int count, int j) { return j * count / MA_PIXEL_CHUNKS; }
+typedef struct {
+  MaVec3 centre;
+  float plain, solidAngle, spread;
+} PixelCell;
 
-MA_FN MaVec3 cellCentre(MA_GLOBAL const float* cell) { return makeVec3(cell[0], cell[1], cell[2]); }
+MA_FN float cellField(MA_GLOBAL const float* cells, int count, int c, int field) { return cells[field * count + c]; }
+
+MA_FN PixelCell pixelCellAt(MA_GLOBAL const float* cells, int count, int c) {
+  PixelCell cell;
+  cell.centre = makeVec3(cellField(cells, count, c, CELL_X), cellField(cells, count, c, CELL_Y),
+                         cellField(cells, count, c, CELL_Z));
+  cell.plain = cellField(cells, count, c, CELL_PLAIN);
+  cell.solidAngle = cellField(cells, count, c, CELL_SOLID_ANGLE);
+  cell.spread = cellField(cells, count, c, CELL_SPREAD);
+  return cell;
+}
 
 // The Phong lobe averaged over a cell rather than taken at its centre: a lobe narrower
 // than the cell would otherwise weigh the cell by its tail at the centre, and a glossy
@@ -76,48 +100,81 @@ MA_FN MaVec3 cellCentre(MA_GLOBAL const float* cell) { return makeVec3(cell[0], 
 // centre along its wider axis (θ or φ: a cell at a pole is a narrow wedge), so that
 // cos^n about the mirror direction spread by the cell is cos^κ' with 1/κ' = 1/n + 1/κ
 // (variances add), scaled by (κ'+1)/(n+1) so that the lobe keeps its mass 2π/(n+1).
-MA_FN float cellLobe(PhongParams b, MA_GLOBAL const float* cell, MaVec3 mirror) {
+MA_FN float cellLobe(PhongParams b, PixelCell cell, MaVec3 mirror) {
   PhongParams spread = b;
-  spread.n = b.n / (1.0f + b.n / cell[5]);  // κ = ∞ (a cell of one texel) spreads nothing
-  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, cellCentre(cell), mirror);
+  spread.n = b.n / (1.0f + b.n / cell.spread);  // κ = ∞ (a cell of one texel) spreads nothing
+  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, cell.centre, mirror);
 }
 
 // max(0, cos θ) averaged over a cell rather than taken at its centre, so that a cell
 // that straddles the horizon keeps the part above it: the angle above the horizon
 // spread uniformly by ±w about the centre's, w = √(3/κ) (the cell's spread), in its
 // small-angle form: the centre's value where the cell lies wholly above, 0 below.
-MA_FN float cellCosine(MaVec3 normal, MA_GLOBAL const float* cell) {
-  float c = dot3(normal, cellCentre(cell)), w = ma_sqrt(3.0f / cell[5]);
+MA_FN float cellCosine(MaVec3 normal, PixelCell cell) {
+  float c = dot3(normal, cell.centre), w = ma_sqrt(3.0f / cell.spread);
   float straddling = (c + w) * (c + w) / (4.0f * w);
   return c >= w ? c : c > -w ? straddling : 0.0f;
 }
 
 // f's mass at cell c: its plain mass times ρ and cos, each averaged over the cell.
-MA_FN float cellIntegrand(MA_GLOBAL const float* cells, int c, PhongParams b, MaVec3 normal, MaVec3 mirror) {
-  MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  return cell[3] * phongBrdf(b, cellLobe(b, cell, mirror)) * cellCosine(normal, cell);
+MA_FN float cellIntegrand(PixelCell cell, PhongParams b, MaVec3 normal, MaVec3 mirror) {
+  return cell.plain * phongBrdf(b, cellLobe(b, cell, mirror)) * cellCosine(normal, cell);
+}
+
+// A cell's f, p_ρ and plain masses; a chunk's sums of them, its cells added in
+// increasing order.
+typedef struct {
+  float f, q, plain;
+} CellMasses;
+
+MA_FN CellMasses zeroCellMasses(void) {
+  CellMasses m;
+  m.f = m.q = m.plain = 0.0f;
+  return m;
+}
+
+MA_FN void addCellMasses(CellMasses* sums, CellMasses m) {
+  sums->f += m.f;
+  sums->q += m.q;
+  sums->plain += m.plain;
 }
 
 // Pass 1, any cell in any order: f and p_ρ's mass at cell c.
-MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
-                                 MaVec3 mirror, MA_LOCAL int* rows, int stride) {
-  MA_GLOBAL const float* cell = cells + MA_CELL_FLOATS * c;
-  setRowFloat(rows, stride, MA_CDF_ROW(c + 1), cellIntegrand(cells, c, b, normal, mirror));
-  setRowFloat(rows, stride, MA_BRDF_ROW(count, c),
-              cell[4] * brdfPdfOf(b, cellCosine(normal, cell), cellLobe(b, cell, mirror)));
+MA_FN CellMasses pixelCellMasses(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
+                                 MaVec3 mirror) {
+  PixelCell cell = pixelCellAt(cells, count, c);
+  CellMasses m;
+  m.f = cellIntegrand(cell, b, normal, mirror);
+  m.q = cell.solidAngle * brdfPdfOf(b, cellCosine(normal, cell), cellLobe(b, cell, mirror));
+  m.plain = cell.plain;
+  return m;
 }
 
-// Pass 2, per chunk: its Σ f, Σ p_ρ and Σ plain.
-MA_FN void pixelOptimalChunkSums(MA_GLOBAL const float* cells, int count, int j, MA_LOCAL int* rows, int stride) {
-  float sumF = 0.0f, sumQ = 0.0f, sumPlain = 0.0f;
-  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
-    sumF += rowFloat(rows, stride, MA_CDF_ROW(c + 1));
-    sumQ += rowFloat(rows, stride, MA_BRDF_ROW(count, c));
-    sumPlain += cells[MA_CELL_FLOATS * c + 3];
-  }
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j), sumF);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j), sumQ);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j), sumPlain);
+// The C++ reference keeps them in the rows for the passes after it (a work-group's lanes
+// keep their own cells' in registers, buildPixelCdfInLanes).
+MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
+                                 MaVec3 mirror, MA_LOCAL int* rows, int stride) {
+  CellMasses m = pixelCellMasses(cells, count, c, b, normal, mirror);
+  setRowFloat(rows, stride, MA_F_ROW(count, c), m.f);
+  setRowFloat(rows, stride, MA_BRDF_ROW(count, c), m.q);
+}
+
+MA_FN CellMasses storedCellMasses(MA_GLOBAL const float* cells, int count, int c, MA_LOCAL const int* rows,
+                                  int stride) {
+  CellMasses m;
+  m.f = rowFloat(rows, stride, MA_F_ROW(count, c));
+  m.q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+  m.plain = cellField(cells, count, c, CELL_PLAIN);
+  return m;
+}
+
+// Pass 2: chunk j's sums into its rows. The C++ reference adds them after pass 1, from
+// the rows (pass 1's loop then has no sum, and a compiler may vectorise it); a
+// work-group's lanes add them as they go.
+MA_FN void setChunkSums(int count, int j, CellMasses sums, MA_LOCAL int* rows, int stride) {
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j), sums.f);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j), sums.q);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j), sums.plain);
 }
 
 MA_FN float chunkTotal(MA_LOCAL const int* rows, int stride, int count, int sum) {
@@ -149,13 +206,12 @@ MA_FN float eq6Value(float f, float q, PixelOptimalTerms t) {
 }
 
 MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
-  return eq6Value(rowFloat(rows, stride, MA_CDF_ROW(c + 1)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
+  return eq6Value(rowFloat(rows, stride, MA_F_ROW(count, c)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
 }
 
-// Pass 3, per chunk: its Σ of eq. 6's terms.
-MA_FN void pixelOptimalChunkEq6(int count, int j, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
-  float mass = 0.0f;
-  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) mass += eq6Term(rows, stride, count, c, t);
+// Pass 3: eq. 6's terms added per chunk, in pass 1's order; chunk j's Σ then goes to
+// its row.
+MA_FN void setChunkEq6(int count, int j, float mass, MA_LOCAL int* rows, int stride) {
   setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j), mass);
 }
 
@@ -207,29 +263,52 @@ MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, 
 // Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
 // offset the table mass of the chunks before it, each entry at most the next chunk's
 // ⌈offset⌉: the CDF never falls across a chunk's edge, however the sums round. The last
-// entry is 1. The envmap's CDF, or the product's (product); the product's first, since
-// the envmap's entries take the place of the chunk's f.
-MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
-                                int product, MA_LOCAL int* rows, int stride) {
-  int first = product ? MA_PRODUCT_CDF_ROW(count, 0) : MA_CDF_ROW(0);
+// entry is 1. The envmap's CDF, or the product's (product). Plain floats, no struct:
+// a struct of floats returned is a short vector, which keeps PoCL's loop scalar
+// (docs/pocl.md, rule 8).
+MA_FN float chunkCdfOffset(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
+                           PixelTableScales s, int product) {
   float offset = 0.0f;
   for (int i = 0; i < j; ++i) offset += chunkTableMass(rows, stride, count, i, t, s, product);
-  float next = ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
-  float partial = 0.0f;
-  for (int c = chunkBegin(count, j); c < chunkBegin(count, j + 1); ++c) {
-    partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cells[MA_CELL_FLOATS * c + 3]);
-    float entry = ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next);
-    setRowFloat(rows, stride, first + c + 1, c + 1 < count ? entry : 1.0f);
+  return offset;
+}
+
+MA_FN float chunkCdfNext(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
+                         PixelTableScales s, int product, float offset) {
+  return ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
+}
+
+// The entry after chunk j's i-th cell, given the chunk's offset, next and partial sum
+// up to that cell.
+MA_FN float chunkCdfEntry(int count, int j, int i, float offset, float partial, float next) {
+  return chunkStart(count, j) + i + 1 < count ? ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next) : 1.0f;
+}
+
+MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_ROW(count, 0) : MA_CDF_ROW(0); }
+
+MA_FN int chunkCdfEntryRow(int count, int j, int i, int product) {
+  return cdfFirstRow(count, product) + chunkStart(count, j) + i + 1;
+}
+
+MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
+                                int product, MA_LOCAL int* rows, int stride) {
+  float offset = chunkCdfOffset(rows, stride, count, j, t, s, product);
+  float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset), partial = 0.0f;
+  for (int i = 0; i < chunkLength(count, j); ++i) {
+    int c = i * MA_PIXEL_CHUNKS + j;
+    partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
+    setRowFloat(rows, stride, chunkCdfEntryRow(count, j, i, product),
+                chunkCdfEntry(count, j, i, offset, partial, next));
   }
-  if (j == 0) setRowFloat(rows, stride, first, 0.0f);
+  if (j == 0) setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
 }
 
 // The share columns' share s of MA_MAX_BANK_SHARES: C_s = (s+1)/(shares+1), the bank's
 // (bankShareOf, kernels/envmap.h).
 MA_FN float columnShare(int s) { return (float)(s + 1) / (float)(MA_MAX_BANK_SHARES + 1); }
 
-// Pass 3b, for the share columns, by one work-item while the rows still hold each cell's
-// f: 1/F, and per share its (1−C)/B and its table's scales, eq. 6's mass summed in cell
+// Pass 3b, for the share columns, by one work-item while the rows hold each cell's f:
+// 1/F, and per share its (1−C)/B and its table's scales, eq. 6's mass summed in cell
 // order. Only the search reads them: their tables need not be the stage's bit for bit.
 MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
@@ -245,28 +324,54 @@ MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
   }
 }
 
-// Pass 4 for chunk j: the product's CDF (with productCdf), then the envmap's.
-MA_FN void pixelOptimalChunkCdfs(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t,
-                                 PixelTableScales s, int productCdf, MA_LOCAL int* rows, int stride) {
-  if (productCdf) {
-    PixelOptimalTerms tp = productTerms(rows, stride, count);
-    pixelOptimalChunkCdf(cells, count, j, tp, productTableScales(rows, stride, count, tp), 1, rows, stride);
-  }
-  pixelOptimalChunkCdf(cells, count, j, t, s, 0, rows, stride);
+// Share s's eq. 6 terms, from the rows pass 3b wrote.
+MA_FN PixelOptimalTerms shareTerms(MA_LOCAL const int* rows, int stride, int count, int s) {
+  PixelOptimalTerms t;
+  t.invF = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F));
+  t.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s));
+  t.lit = 1;
+  return t;
 }
 
-// The whole build by one work-item (sampleStage, the C++ reference): the pixel's CDF over
-// `count` cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
+// The product technique's terms and table scales (eq. 6 at C = 1).
+typedef struct {
+  PixelOptimalTerms t;
+  PixelTableScales s;
+} ProductCdfTerms;
+
+MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int count) {
+  ProductCdfTerms p;
+  p.t = productTerms(rows, stride, count);
+  p.s = productTableScales(rows, stride, count, p.t);
+  return p;
+}
+
+// The whole build by one work-item (the C++ reference): the pixel's CDF over `count`
+// cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
 // `shareColumns`, the share columns' scales too; with `productCdf`, the product's CDF.
+// sampleStage and samplePixelStage run the same passes with barriers between them.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
                                 float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkSums(cells, count, j, rows, stride);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
+    CellMasses sums = zeroCellMasses();
+    for (int i = 0; i < chunkLength(count, j); ++i)
+      addCellMasses(&sums, storedCellMasses(cells, count, i * MA_PIXEL_CHUNKS + j, rows, stride));
+    setChunkSums(count, j, sums, rows, stride);
+  }
   PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkEq6(count, j, t, rows, stride);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
+    float mass = 0.0f;
+    for (int i = 0; i < chunkLength(count, j); ++i) mass += eq6Term(rows, stride, count, i * MA_PIXEL_CHUNKS + j, t);
+    setChunkEq6(count, j, mass, rows, stride);
+  }
   if (shareColumns) pixelOptimalShareScales(count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdfs(cells, count, j, t, s, productCdf, rows, stride);
+  if (productCdf) {
+    ProductCdfTerms p = productCdfTerms(rows, stride, count);
+    for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, p.t, p.s, 1, rows, stride);
+  }
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, t, s, 0, rows, stride);
 }
 
 // The product technique's view of the pixel's cells: the envmap's, over the product's CDF.
@@ -282,14 +387,12 @@ MA_FN void pixelSharePdfs(EnvmapView env, PhongParams b, MaVec3 normal, MaVec3 m
                           float* pdfs) {
   MA_LOCAL const int* rows = env.pixelCdf;
   int count = env.pixelCells, stride = env.pixelCdfStride, c = blockOfTexel(env, t);
-  float f = cellIntegrand(env.blockProbs, c, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
-  float plain = env.blockProbs[MA_CELL_FLOATS * c + 3], inCell = env.texels[4 * t + 3];
-  PixelOptimalTerms terms;
-  terms.invF = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F));
-  terms.lit = 1;
+  PixelCell cell = pixelCellAt(env.blockProbs, count, c);
+  float f = cellIntegrand(cell, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
+  float plain = cell.plain, inCell = env.texels[4 * t + 3];
   MA_UNROLL
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
-    terms.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s));
+    PixelOptimalTerms terms = shareTerms(rows, stride, count, s);
     PixelTableScales scales;
     scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_OPTIMAL + s));
     scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_PLAIN + s));

@@ -355,33 +355,83 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
 }
 
 #if MA_PIXEL_CELLS > 0
-// buildPixelOptimalCdf's passes, each shared among the lanes chunk by chunk. The
-// background's loops run no turns, and every lane meets every barrier.
+#if MA_PIXEL_CHUNKS % MA_PIXEL_LANES != 0
+#error "each lane takes whole chunks of the per-pixel table"
+#endif
+#define CHUNKS_PER_LANE (MA_PIXEL_CHUNKS / MA_PIXEL_LANES)
+// buildPixelOptimalCdf's passes, each shared among the lanes, in straight code, lane l
+// taking cells l, L + l, ...: a loop left here keeps PoCL from vectorising across the
+// lanes (the lobe's exp and log dominate). Lane l's cells lie in chunks l, L + l, ...
+// (L divides the chunks), which it alone adds to and writes the entries of. A
+// background pixel builds its table too; nothing reads it.
+#define CELL_STEPS ((MA_PIXEL_CELLS + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES)
+#define CELL_EXISTS(c) (MA_PIXEL_CELLS % MA_PIXEL_LANES == 0 || (c) < MA_PIXEL_CELLS)
+
+// The CDF's entries from the masses of the lane's cells (f, q), lane l writing chunks l,
+// L + l, ...: straight code, as the passes before it. Their stores are unconditional
+// (rule 9): a lane past the last cell writes its chunk's spare row.
+MA_FN void chunkCdfsInLanes(__global const float* cells, const float* f, const float* q, PixelOptimalTerms t,
+                            PixelTableScales s, int product, __local int* rows, int lid) {
+  float offset[CHUNKS_PER_LANE], next[CHUNKS_PER_LANE], partial[CHUNKS_PER_LANE];
+  MA_UNROLL
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
+    int j = h * MA_PIXEL_LANES + lid;
+    offset[h] = chunkCdfOffset(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, j, t, s, product);
+    next[h] = chunkCdfNext(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, j, t, s, product, offset[h]);
+    partial[h] = 0.0f;
+  }
+  MA_UNROLL
+  for (int k = 0; k < CELL_STEPS; ++k) {
+    int h = k % CHUNKS_PER_LANE, i = k / CHUNKS_PER_LANE, j = h * MA_PIXEL_LANES + lid, c = k * MA_PIXEL_LANES + lid;
+    int exists = CELL_EXISTS(c);
+    float plain = exists ? cellField(cells, MA_PIXEL_CELLS, exists ? c : 0, CELL_PLAIN) : 0.0f;
+    partial[h] += cellTableMass(s, eq6Value(f[k], q[k], t), plain);
+    setRowFloat(rows, PIXEL_ROW_STRIDE,
+                exists ? chunkCdfEntryRow(MA_PIXEL_CELLS, j, i, product) : MA_SPARE_ROW(MA_PIXEL_CELLS, j),
+                chunkCdfEntry(MA_PIXEL_CELLS, j, i, offset[h], partial[h], next[h]));
+  }
+  if (lid == 0) setRowFloat(rows, PIXEL_ROW_STRIDE, cdfFirstRow(MA_PIXEL_CELLS, product), 0.0f);
+}
+
+// Each lane keeps its own cells' masses in registers from pass 1 to pass 4: only the
+// chunks' sums go through local memory. (PoCL still runs these passes 4 wide: it keeps
+// 64-bit values per lane across their barriers; docs/pocl.md, rule 10.)
 MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* cells, int stageSamples, int lid) {
   __local int* rows = pixelRows + ROW_PIXEL_CDF * PIXEL_ROW_STRIDE;
-  int chunkEnd = oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0) > 0 ? MA_PIXEL_CHUNKS : 0;
   PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
-  // The cells' terms in straight code, lane l taking cells l, L + l, ...: a loop left
-  // here keeps PoCL from vectorising across the lanes (the lobe's exp and log dominate).
-  // Their stores are unconditional where the lanes divide the cells (docs/pocl.md, rule
-  // 9): a background pixel's rows are written too, and nothing reads them.
+  float f[CELL_STEPS], q[CELL_STEPS];
+  CellMasses sums[CHUNKS_PER_LANE];
   MA_UNROLL
-  for (int k = 0; k < (MA_PIXEL_CELLS + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES; ++k) {
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h) sums[h] = zeroCellMasses();
+  MA_UNROLL
+  for (int k = 0; k < CELL_STEPS; ++k) {
     int c = k * MA_PIXEL_LANES + lid;
-    if (MA_PIXEL_CELLS % MA_PIXEL_LANES == 0 || c < MA_PIXEL_CELLS)
-      pixelOptimalCellTerms(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror, rows, PIXEL_ROW_STRIDE);
+    CellMasses m = zeroCellMasses();
+    if (CELL_EXISTS(c)) m = pixelCellMasses(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror);
+    f[k] = m.f;
+    q[k] = m.q;
+    addCellMasses(&sums[k % CHUNKS_PER_LANE], m);
   }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
-    pixelOptimalChunkSums(cells, MA_PIXEL_CELLS, j, rows, PIXEL_ROW_STRIDE);
+  MA_UNROLL
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h)
+    setChunkSums(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, sums[h], rows, PIXEL_ROW_STRIDE);
   barrier(CLK_LOCAL_MEM_FENCE);
   PixelOptimalTerms t = pixelOptimalTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, in.envmapShare);
-  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
-    pixelOptimalChunkEq6(MA_PIXEL_CELLS, j, t, rows, PIXEL_ROW_STRIDE);
+  float mass[CHUNKS_PER_LANE];
+  MA_UNROLL
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h) mass[h] = 0.0f;
+  MA_UNROLL
+  for (int k = 0; k < CELL_STEPS; ++k) mass[k % CHUNKS_PER_LANE] += eq6Value(f[k], q[k], t);
+  MA_UNROLL
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h)
+    setChunkEq6(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, mass[h], rows, PIXEL_ROW_STRIDE);
   barrier(CLK_LOCAL_MEM_FENCE);
   PixelTableScales s = pixelTableScales(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, t);
-  for (int j = lid; j < chunkEnd; j += MA_PIXEL_LANES)
-    pixelOptimalChunkCdfs(cells, MA_PIXEL_CELLS, j, t, s, MA_PRODUCT_CELLS, rows, PIXEL_ROW_STRIDE);
+#if MA_PRODUCT_CELLS
+  ProductCdfTerms p = productCdfTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS);
+  chunkCdfsInLanes(cells, f, q, p.t, p.s, 1, rows, lid);
+#endif
+  chunkCdfsInLanes(cells, f, q, t, s, 0, rows, lid);
   barrier(CLK_LOCAL_MEM_FENCE);
 }
 #endif

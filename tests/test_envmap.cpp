@@ -654,8 +654,8 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
   // orders of magnitude, either way (0 or 200× at n = 10⁴): the case this exists for.
   EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", 1024), 16);
   REQUIRE(tables.pixelCells == 16 * 8);
-  auto cell = [&](int c) { return tables.blockProbs.data() + MA_CELL_FLOATS * c; };
-  auto centre = [&](int c) { return kern::cellCentre(cell(c)); };
+  auto cell = [&](int c) { return kern::pixelCellAt(tables.blockProbs.data(), tables.pixelCells, c); };
+  auto centre = [&](int c) { return cell(c).centre; };
   auto normalised = [](double x, double y, double z) {
     double r = std::sqrt(x * x + y * y + z * z);
     return kern::makeVec3(float(x / r), float(y / r), float(z / r));
@@ -676,7 +676,8 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
     for (const kern::MaVec3& mirror : mirrors) {
       INFO("mirror " << mirror.x << ", " << mirror.y << ", " << mirror.z);
       double mass = 0;
-      for (int k = 0; k < tables.pixelCells; ++k) mass += double(cell(k)[4]) * kern::cellLobe(brdf, cell(k), mirror);
+      for (int k = 0; k < tables.pixelCells; ++k)
+        mass += double(cell(k).solidAngle) * kern::cellLobe(brdf, cell(k), mirror);
       const double ratio = mass / (2 * kPi / (double(n) + 1));
       if (n <= 10.0f)
         CHECK(std::abs(ratio - 1) <= 0.1);
@@ -690,8 +691,8 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
     EnvmapTables small = misalloc::buildPixelOptimalEnvmapTables(map);
     for (int k = 0; k < small.pixelCells; ++k)
       for (float n : {0.0f, 1.0f, 1e5f}) {
-        const float* c = small.blockProbs.data() + MA_CELL_FLOATS * k;
-        const float lobe = kern::cellLobe({0.0f, 1.0f, n}, c, kern::cellCentre(c));
+        const kern::PixelCell c = kern::pixelCellAt(small.blockProbs.data(), small.pixelCells, k);
+        const float lobe = kern::cellLobe({0.0f, 1.0f, n}, c, c.centre);
         CHECK((std::isfinite(lobe) && lobe > 0.0f));
       }
   }
@@ -723,10 +724,10 @@ TEST_CASE("the optimal pdf per pixel weighs cos θ by its mean over a cell, the 
       }
     double errorMean = 0, errorCentre = 0;
     for (int k = 0; k < tables.pixelCells; ++k) {
-      const float* cell = tables.blockProbs.data() + MA_CELL_FLOATS * k;
+      const kern::PixelCell cell = kern::pixelCellAt(tables.blockProbs.data(), tables.pixelCells, k);
       const double exact = mean[std::size_t(k)] / weight[std::size_t(k)];
-      errorMean += cell[4] * std::abs(kern::cellCosine(normal, cell) - exact);
-      errorCentre += cell[4] * std::abs(std::max(0.0f, kern::dot3(normal, kern::cellCentre(cell))) - exact);
+      errorMean += cell.solidAngle * std::abs(kern::cellCosine(normal, cell) - exact);
+      errorCentre += cell.solidAngle * std::abs(std::max(0.0f, kern::dot3(normal, cell.centre)) - exact);
     }
     CHECK(errorMean / kPi <= 0.025);
     totalMean += errorMean;

@@ -426,20 +426,21 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
-  // Cells: the centre of the texels they hold, the plain mass, the solid angle, the spread.
+  // Cells: the centre of the texels they hold, the plain mass, the solid angle, the spread
+  // (kernels/pixel_optimal.h, CELL_*).
   tables.blockProbs.assign(std::size_t(tables.pixelCells) * MA_CELL_FLOATS, 0.0f);
   for (int cell = 0; cell < tables.pixelCells; ++cell) {
     const int col0 = (cell % across) * side, row0 = (cell / across) * side;
     const float u = float((col0 + 0.5 * std::min(side, width - col0)) / width);
     const float v = float((row0 + 0.5 * std::min(side, height - row0)) / height);
     const kern::MaVec3 centre = kern::latLongDirection(u, v);
-    float* out = tables.blockProbs.data() + std::size_t(cell) * MA_CELL_FLOATS;
-    out[0] = centre.x;
-    out[1] = centre.y;
-    out[2] = centre.z;
-    out[3] = float(mass[std::size_t(cell)] / plain.total);
-    out[4] = float(solidAngle[std::size_t(cell)]);
-    out[5] = spreads[std::size_t(cell)];
+    auto field = [&](int f) -> float& { return tables.blockProbs[std::size_t(f) * tables.pixelCells + cell]; };
+    field(kern::CELL_X) = centre.x;
+    field(kern::CELL_Y) = centre.y;
+    field(kern::CELL_Z) = centre.z;
+    field(kern::CELL_PLAIN) = float(mass[std::size_t(cell)] / plain.total);
+    field(kern::CELL_SOLID_ANGLE) = float(solidAngle[std::size_t(cell)]);
+    field(kern::CELL_SPREAD) = spreads[std::size_t(cell)];
   }
   tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
