@@ -644,6 +644,32 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   checkDrawnTexels(view, p, 200000, 0x7a1, 1, 0.001);
 }
 
+TEST_CASE("the optimal pdf per pixel's CDF runs over its cells chunk by chunk, each cell once", "[envmap][optimal]") {
+  // kernels/pixel_layout.h: chunk j holds cells j, j + 16, ...; the CDF takes chunk 0's
+  // cells, then chunk 1's, ... The search returns the cell at the position it finds and
+  // the pdf reads a cell's entries at its position: both must be one bijection, also
+  // where the cells are fewer than the chunks or no multiple of them (maps of any size).
+  for (int count : {1, 8, 15, 16, 17, 20, 128, 320, 512, 513, 2047, 2048}) {
+    INFO("cells " << count);
+    std::vector<int> cellAt(std::size_t(count), -1);
+    for (int c = 0; c < count; ++c) {
+      const int p = kern::cdfPositionOfCell(count, c);
+      REQUIRE((p >= 0 && p < count));
+      CHECK(cellAt[std::size_t(p)] == -1);
+      cellAt[std::size_t(p)] = c;
+      CHECK(kern::cellAtCdfPosition(count, p) == c);
+    }
+    // Each chunk's cells take consecutive positions, in increasing order, from its start.
+    int p = 0;
+    for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
+      CHECK(kern::chunkStart(count, j) == p);
+      for (int i = 0; i < kern::chunkLength(count, j); ++i, ++p)
+        CHECK(cellAt[std::size_t(p)] == i * MA_PIXEL_CHUNKS + j);
+    }
+    CHECK(p == count);
+  }
+}
+
 TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell, not by its value at the centre",
           "[envmap][optimal]") {
   // kernels/pixel_optimal.h, cellLobe: summed over the cells, each cell's solid angle
