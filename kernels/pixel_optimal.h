@@ -263,9 +263,9 @@ MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, 
 // Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
 // offset the table mass of the chunks before it, each entry at most the next chunk's
 // ⌈offset⌉: the CDF never falls across a chunk's edge, however the sums round. The last
-// entry is 1. The envmap's CDF, or the product's (product). Plain floats, no struct:
-// a struct of floats returned is a short vector, which keeps PoCL's loop scalar
-// (docs/pocl.md, rule 8).
+// entry is 1. The envmap's CDF, or the product's (product). A chunk's running
+// state is plain floats, no struct: a struct of floats carried by a loop is a short
+// vector, which keeps PoCL's loop scalar (docs/pocl.md, rule 11).
 MA_FN float chunkCdfOffset(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
                            PixelTableScales s, int product) {
   float offset = 0.0f;
