@@ -278,17 +278,15 @@ MA_FN float chunkCdfNext(MA_LOCAL const int* rows, int stride, int count, int j,
   return ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
 }
 
-// The entry after chunk j's i-th cell, given the chunk's offset, next and partial sum
-// up to that cell.
-MA_FN float chunkCdfEntry(int count, int j, int i, float offset, float partial, float next) {
-  return chunkStart(count, j) + i + 1 < count ? ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next) : 1.0f;
+// The entry after the cell at CDF position p, given its chunk's offset, next and
+// partial sum up to that cell.
+MA_FN float chunkCdfEntry(int count, int p, float offset, float partial, float next) {
+  return p + 1 < count ? ma_min(ceilToUniformGrid(ma_min(offset + partial, 1.0f)), next) : 1.0f;
 }
 
 MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_ROW(count, 0) : MA_CDF_ROW(0); }
 
-MA_FN int chunkCdfEntryRow(int count, int j, int i, int product) {
-  return cdfFirstRow(count, product) + chunkStart(count, j) + i + 1;
-}
+MA_FN int cdfEntryRow(int count, int p, int product) { return cdfFirstRow(count, product) + p + 1; }
 
 MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
                                 int product, MA_LOCAL int* rows, int stride) {
@@ -296,9 +294,9 @@ MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, 
   float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset), partial = 0.0f;
   for (int i = 0; i < chunkLength(count, j); ++i) {
     int c = i * MA_PIXEL_CHUNKS + j;
+    int p = chunkStart(count, j) + i;
     partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
-    setRowFloat(rows, stride, chunkCdfEntryRow(count, j, i, product),
-                chunkCdfEntry(count, j, i, offset, partial, next));
+    setRowFloat(rows, stride, cdfEntryRow(count, p, product), chunkCdfEntry(count, p, offset, partial, next));
   }
   if (j == 0) setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
 }

@@ -359,19 +359,30 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
 #error "each lane takes whole chunks of the per-pixel table"
 #endif
 #define CHUNKS_PER_LANE (MA_PIXEL_CHUNKS / MA_PIXEL_LANES)
-// buildPixelOptimalCdf's passes, each shared among the lanes, in straight code, lane l
-// taking cells l, L + l, ...: a loop left here keeps PoCL from vectorising across the
-// lanes (the lobe's exp and log dominate). Lane l's cells lie in chunks l, L + l, ...
-// (L divides the chunks), which it alone adds to and writes the entries of. A
-// background pixel builds its table too; nothing reads it.
-#define CELL_STEPS ((MA_PIXEL_CELLS + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES)
-#define CELL_EXISTS(c) (MA_PIXEL_CELLS % MA_PIXEL_LANES == 0 || (c) < MA_PIXEL_CELLS)
+// buildPixelOptimalCdf's passes, each shared among the lanes in turns: turn i takes each
+// chunk's i-th cell, lane l chunks l, L + l, ... (L divides the chunks), whose sums and
+// CDF entries it alone writes. A barrier closes each turn, so that PoCL runs a turn
+// across the lanes (docs/pocl.md, rule 1) and compiles one turn, not one copy of the
+// lobe's exp and log per cell. What a turn carries to the next is plain floats, and its
+// cell (iK) xor j, which is iK + j: a struct kept across a barrier stays a short vector
+// (rule 11), and iK + j becomes a 64-bit induction variable, which PoCL keeps per lane
+// (rule 10); either made the turns 3× slower. A background pixel builds its table too;
+// nothing reads it.
+#define CHUNK_TURNS ((MA_PIXEL_CELLS + MA_PIXEL_CHUNKS - 1) / MA_PIXEL_CHUNKS)
+#define CELL_EXISTS(c) (MA_PIXEL_CELLS % MA_PIXEL_CHUNKS == 0 || (c) < MA_PIXEL_CELLS)
 
-// The CDF's entries from the masses of the lane's cells (f, q), lane l writing chunks l,
-// L + l, ...: straight code, as the passes before it. Their stores are unconditional
-// (rule 9): a lane past the last cell writes its chunk's spare row.
-MA_FN void chunkCdfsInLanes(__global const float* cells, const float* f, const float* q, PixelOptimalTerms t,
-                            PixelTableScales s, int product, __local int* rows, int lid) {
+// Row r of cell c, or chunk j's spare row past the last cell: the stores stay
+// unconditional (rule 9), and the reads in bounds.
+MA_FN int laneCellRow(int r, int c, int j) { return CELL_EXISTS(c) ? r : MA_SPARE_ROW(MA_PIXEL_CELLS, j); }
+
+MA_FN float laneCellMass(__local const int* rows, int r, int c, int j) {
+  return CELL_EXISTS(c) ? rowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(r, c, j)) : 0.0f;
+}
+
+// Pass 4's CDF entries, the envmap's or the product's, in turns; the last turn's barrier
+// ends the build.
+MA_FN void chunkCdfsInLanes(__global const float* cells, PixelOptimalTerms t, PixelTableScales s, int product,
+                            __local int* rows, int lid) {
   float offset[CHUNKS_PER_LANE], next[CHUNKS_PER_LANE], partial[CHUNKS_PER_LANE];
   MA_UNROLL
   for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
@@ -380,48 +391,68 @@ MA_FN void chunkCdfsInLanes(__global const float* cells, const float* f, const f
     next[h] = chunkCdfNext(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, j, t, s, product, offset[h]);
     partial[h] = 0.0f;
   }
-  MA_UNROLL
-  for (int k = 0; k < CELL_STEPS; ++k) {
-    int h = k % CHUNKS_PER_LANE, i = k / CHUNKS_PER_LANE, j = h * MA_PIXEL_LANES + lid, c = k * MA_PIXEL_LANES + lid;
-    int exists = CELL_EXISTS(c);
-    float plain = exists ? cellField(cells, MA_PIXEL_CELLS, exists ? c : 0, CELL_PLAIN) : 0.0f;
-    partial[h] += cellTableMass(s, eq6Value(f[k], q[k], t), plain);
-    setRowFloat(rows, PIXEL_ROW_STRIDE,
-                exists ? chunkCdfEntryRow(MA_PIXEL_CELLS, j, i, product) : MA_SPARE_ROW(MA_PIXEL_CELLS, j),
-                chunkCdfEntry(MA_PIXEL_CELLS, j, i, offset[h], partial[h], next[h]));
-  }
   if (lid == 0) setRowFloat(rows, PIXEL_ROW_STRIDE, cdfFirstRow(MA_PIXEL_CELLS, product), 0.0f);
+  for (int i = 0; i < CHUNK_TURNS; ++i) {
+    MA_UNROLL
+    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
+      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j, exists = CELL_EXISTS(c);
+      float f = laneCellMass(rows, MA_F_ROW(MA_PIXEL_CELLS, c), c, j);
+      float q = laneCellMass(rows, MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j);
+      float plain = exists ? cellField(cells, MA_PIXEL_CELLS, exists ? c : 0, CELL_PLAIN) : 0.0f;
+      partial[h] += cellTableMass(s, eq6Value(f, q, t), plain);
+      int p = cdfPositionOfCell(MA_PIXEL_CELLS, c);
+      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(cdfEntryRow(MA_PIXEL_CELLS, p, product), c, j),
+                  chunkCdfEntry(MA_PIXEL_CELLS, p, offset[h], partial[h], next[h]));
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
 }
 
-// Each lane keeps its own cells' masses in registers from pass 1 to pass 4: only the
-// chunks' sums go through local memory. (PoCL still runs these passes 4 wide: it keeps
-// 64-bit values per lane across their barriers; docs/pocl.md, rule 10.)
+// The lanes add their chunks' sums as they go (the C++ reference adds them after pass 1,
+// in the same order), and read the pixel's inputs anew in each turn.
 MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* cells, int stageSamples, int lid) {
   __local int* rows = pixelRows + ROW_PIXEL_CDF * PIXEL_ROW_STRIDE;
-  PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
-  float f[CELL_STEPS], q[CELL_STEPS];
-  CellMasses sums[CHUNKS_PER_LANE];
+  float sumF[CHUNKS_PER_LANE], sumQ[CHUNKS_PER_LANE], sumPlain[CHUNKS_PER_LANE];
   MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h) sums[h] = zeroCellMasses();
-  MA_UNROLL
-  for (int k = 0; k < CELL_STEPS; ++k) {
-    int c = k * MA_PIXEL_LANES + lid;
-    CellMasses m = zeroCellMasses();
-    if (CELL_EXISTS(c)) m = pixelCellMasses(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror);
-    f[k] = m.f;
-    q[k] = m.q;
-    addCellMasses(&sums[k % CHUNKS_PER_LANE], m);
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h) sumF[h] = sumQ[h] = sumPlain[h] = 0.0f;
+  for (int i = 0; i < CHUNK_TURNS; ++i) {
+    PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
+    MA_UNROLL
+    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
+      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j;
+      CellMasses m = zeroCellMasses();
+      if (CELL_EXISTS(c)) m = pixelCellMasses(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror);
+      sumF[h] += m.f;
+      sumQ[h] += m.q;
+      sumPlain[h] += m.plain;
+      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(MA_F_ROW(MA_PIXEL_CELLS, c), c, j), m.f);
+      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j), m.q);
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
   }
   MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h)
-    setChunkSums(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, sums[h], rows, PIXEL_ROW_STRIDE);
+  for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
+    CellMasses sums;
+    sums.f = sumF[h];
+    sums.q = sumQ[h];
+    sums.plain = sumPlain[h];
+    setChunkSums(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, sums, rows, PIXEL_ROW_STRIDE);
+  }
   barrier(CLK_LOCAL_MEM_FENCE);
+  PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
   PixelOptimalTerms t = pixelOptimalTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, in.envmapShare);
   float mass[CHUNKS_PER_LANE];
   MA_UNROLL
   for (int h = 0; h < CHUNKS_PER_LANE; ++h) mass[h] = 0.0f;
-  MA_UNROLL
-  for (int k = 0; k < CELL_STEPS; ++k) mass[k % CHUNKS_PER_LANE] += eq6Value(f[k], q[k], t);
+  for (int i = 0; i < CHUNK_TURNS; ++i) {
+    MA_UNROLL
+    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
+      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j;
+      mass[h] += eq6Value(laneCellMass(rows, MA_F_ROW(MA_PIXEL_CELLS, c), c, j),
+                          laneCellMass(rows, MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j), t);
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
   MA_UNROLL
   for (int h = 0; h < CHUNKS_PER_LANE; ++h)
     setChunkEq6(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, mass[h], rows, PIXEL_ROW_STRIDE);
@@ -429,10 +460,9 @@ MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* ce
   PixelTableScales s = pixelTableScales(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, t);
 #if MA_PRODUCT_CELLS
   ProductCdfTerms p = productCdfTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS);
-  chunkCdfsInLanes(cells, f, q, p.t, p.s, 1, rows, lid);
+  chunkCdfsInLanes(cells, p.t, p.s, 1, rows, lid);
 #endif
-  chunkCdfsInLanes(cells, f, q, t, s, 0, rows, lid);
-  barrier(CLK_LOCAL_MEM_FENCE);
+  chunkCdfsInLanes(cells, t, s, 0, rows, lid);
 }
 #endif
 
