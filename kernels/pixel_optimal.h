@@ -47,9 +47,8 @@ enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
-// count + 1 entries in its order (cdfPositionOfCell), as float bits; then, where one
-// work-item builds the table, each cell's p_ρ mass and its f in the cells' order (the
-// share columns read the p_ρ masses; samplePixelStage keeps both in registers); then
+// count + 1 entries in its order (cdfPositionOfCell), as float bits; then each cell's
+// p_ρ mass and its f in the cells' order (the share columns read the p_ρ masses); then
 // per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms; then a spare row per chunk,
 // which a lane with no cell of the chunk to write writes. (f in the CDF's rows, at its
 // cell's position, would save count rows, but pass 1's stores would no longer lie side
@@ -150,8 +149,7 @@ MA_FN CellMasses pixelCellMasses(MA_GLOBAL const float* cells, int count, int c,
   return m;
 }
 
-// The C++ reference keeps them in the rows for the passes after it (a work-group's lanes
-// keep their own cells' in registers, buildPixelCdfInLanes).
+// Kept in the rows for the passes after it.
 MA_FN void pixelOptimalCellTerms(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
                                  MaVec3 mirror, MA_LOCAL int* rows, int stride) {
   CellMasses m = pixelCellMasses(cells, count, c, b, normal, mirror);
@@ -347,7 +345,7 @@ MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int 
 // The whole build by one work-item (the C++ reference): the pixel's CDF over `count`
 // cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
 // `shareColumns`, the share columns' scales too; with `productCdf`, the product's CDF.
-// sampleStage and samplePixelStage run the same passes with barriers between them.
+// samplePixelStage runs the same passes shared among its lanes (buildPixelCdfInLanes).
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
                                 float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);

@@ -372,12 +372,9 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
 #define CELL_EXISTS(c) (MA_PIXEL_CELLS % MA_PIXEL_CHUNKS == 0 || (c) < MA_PIXEL_CELLS)
 
 // Row r of cell c, or chunk j's spare row past the last cell: the stores stay
-// unconditional (rule 9), and the reads in bounds.
+// unconditional (rule 9). A lane past the last cell reads cell 0's rows, and adds 0.
 MA_FN int laneCellRow(int r, int c, int j) { return CELL_EXISTS(c) ? r : MA_SPARE_ROW(MA_PIXEL_CELLS, j); }
-
-MA_FN float laneCellMass(__local const int* rows, int r, int c, int j) {
-  return CELL_EXISTS(c) ? rowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(r, c, j)) : 0.0f;
-}
+MA_FN int laneReadCell(int c) { return CELL_EXISTS(c) ? c : 0; }
 
 // Pass 4's CDF entries, the envmap's or the product's, in turns; the last turn's barrier
 // ends the build.
@@ -395,11 +392,10 @@ MA_FN void chunkCdfsInLanes(__global const float* cells, PixelOptimalTerms t, Pi
   for (int i = 0; i < CHUNK_TURNS; ++i) {
     MA_UNROLL
     for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j, exists = CELL_EXISTS(c);
-      float f = laneCellMass(rows, MA_F_ROW(MA_PIXEL_CELLS, c), c, j);
-      float q = laneCellMass(rows, MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j);
-      float plain = exists ? cellField(cells, MA_PIXEL_CELLS, exists ? c : 0, CELL_PLAIN) : 0.0f;
-      partial[h] += cellTableMass(s, eq6Value(f, q, t), plain);
+      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j, r = laneReadCell(c);
+      float mass = cellTableMass(s, eq6Term(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, r, t),
+                                 cellField(cells, MA_PIXEL_CELLS, r, CELL_PLAIN));
+      partial[h] += CELL_EXISTS(c) ? mass : 0.0f;
       int p = cdfPositionOfCell(MA_PIXEL_CELLS, c);
       setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(cdfEntryRow(MA_PIXEL_CELLS, p, product), c, j),
                   chunkCdfEntry(MA_PIXEL_CELLS, p, offset[h], partial[h], next[h]));
@@ -447,9 +443,9 @@ MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* ce
   for (int i = 0; i < CHUNK_TURNS; ++i) {
     MA_UNROLL
     for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j;
-      mass[h] += eq6Value(laneCellMass(rows, MA_F_ROW(MA_PIXEL_CELLS, c), c, j),
-                          laneCellMass(rows, MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j), t);
+      int c = (i * MA_PIXEL_CHUNKS) ^ (h * MA_PIXEL_LANES + lid);
+      float eq6 = eq6Term(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, laneReadCell(c), t);
+      mass[h] += CELL_EXISTS(c) ? eq6 : 0.0f;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
   }
