@@ -42,8 +42,8 @@ enum {
 #define MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) \
   (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
 // The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
-// scratch, 2 pixelCells entries and 5 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS,
-// MA_SPARE_ROW), then the scales of the tables of the share columns' shares, 1 + 3 per
+// scratch, 2 pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS),
+// then the scales of the tables of the share columns' shares, 1 + 3 per
 // share for at most 3 shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES),
 // then with the product technique from the same cells (productCells) its CDF's
 // pixelCells + 1 entries.
@@ -51,7 +51,7 @@ enum {
 #define MA_PIXEL_SHARE_ROWS 10
 #define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                                                 \
   ((pixelCells) > 0                                                                                                 \
-       ? 3 * (pixelCells) + 1 + 5 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
+       ? 3 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
        : 0)
 #define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells) \
   (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells))
@@ -61,6 +61,24 @@ enum {
 MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells, int productCells) {
   return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells);
 }
+
+// The words of a pixel's block of rows in samplePixelStage (kernels/sample.cl): the
+// least power of two that holds its `rows` rows, up to 2^20.
+#define MA_ROW_BLOCK(rows)     \
+  ((rows) <= 256      ? 256    \
+   : (rows) <= 512    ? 512    \
+   : (rows) <= 1024   ? 1024   \
+   : (rows) <= 2048   ? 2048   \
+   : (rows) <= 4096   ? 4096   \
+   : (rows) <= 8192   ? 8192   \
+   : (rows) <= 16384  ? 16384  \
+   : (rows) <= 32768  ? 32768  \
+   : (rows) <= 65536  ? 65536  \
+   : (rows) <= 131072 ? 131072 \
+   : (rows) <= 262144 ? 262144 \
+   : (rows) <= 524288 ? 524288 \
+                      : 1048576)
+MA_FN int pixelRowBlock(int rows) { return MA_ROW_BLOCK(rows); }
 
 // The order of the pixel's CDF over its cells: chunk by chunk, chunk j holding cells j,
 // j + K, j + 2K, ... (K = MA_PIXEL_CHUNKS). The build adds each chunk's masses and

@@ -16,9 +16,10 @@
 // is read from the same CDF, so the estimator is unbiased however coarse the cells are.
 //
 // The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them
-// (kernels/pixel_layout.h, chunkOfCell), so that a work-group of one pixel
-// (samplePixelStage) shares a pass among its lanes while its sums keep the order that a
-// single work-item and the C++ reference add them in: each chunk's cells in turn.
+// (kernels/pixel_layout.h, chunkOfCell), its sums added chunk by chunk. Each work-item
+// builds its own pixel's table (sampleStage, and samplePixelStage's lanes one pixel
+// each), so the chunks no longer split one build among lanes; they remain the CDF's
+// order.
 //
 // A stage that stores its samples for the grid search of `exact` (kernels/stats.h, share
 // columns) also keeps the scales of the tables that stages of the shares C = 1/4, 1/2,
@@ -49,8 +50,7 @@ enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
 // count + 1 entries in its order (cdfPositionOfCell), as float bits; then each cell's
 // p_ρ mass and its f in the cells' order (the share columns read the p_ρ masses); then
-// per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms; then a spare row per chunk,
-// which a lane with no cell of the chunk to write writes. (f in the CDF's rows, at its
+// per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms. (f in the CDF's rows, at its
 // cell's position, would save count rows, but pass 1's stores would no longer lie side
 // by side, and the compiler no longer vectorises it: 2.2× the time of the pilot stage.)
 #define MA_CDF_ROW(p) (p)
@@ -58,7 +58,6 @@ enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 #define MA_F_ROW(count, c) (2 * (count) + 1 + (c))
 enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
 #define MA_CHUNK_ROW(count, sum, j) (3 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
-#define MA_SPARE_ROW(count, j) MA_CHUNK_ROW(count, CHUNK_SUMS, j)
 // Then, for the share columns, 1/F and per share its table's (1−C)/B, optimal and plain
 // scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows.
 enum {
@@ -68,7 +67,7 @@ enum {
   SHARE_PLAIN = SHARE_OPTIMAL + MA_MAX_BANK_SHARES,
   SHARE_ROWS = SHARE_PLAIN + MA_MAX_BANK_SHARES
 };
-#define MA_SHARE_ROW(count, q) (MA_SPARE_ROW(count, MA_PIXEL_CHUNKS) + (q))
+#define MA_SHARE_ROW(count, q) (MA_CHUNK_ROW(count, CHUNK_SUMS, 0) + (q))
 // Then the product technique's CDF, count + 1 entries.
 #define MA_PRODUCT_CDF_ROW(count, c) (MA_SHARE_ROW(count, SHARE_ROWS) + (c))
 
@@ -126,18 +125,6 @@ typedef struct {
   float f, q, plain;
 } CellMasses;
 
-MA_FN CellMasses zeroCellMasses(void) {
-  CellMasses m;
-  m.f = m.q = m.plain = 0.0f;
-  return m;
-}
-
-MA_FN void addCellMasses(CellMasses* sums, CellMasses m) {
-  sums->f += m.f;
-  sums->q += m.q;
-  sums->plain += m.plain;
-}
-
 // Pass 1, any cell in any order: f and p_ρ's mass at cell c.
 MA_FN CellMasses pixelCellMasses(MA_GLOBAL const float* cells, int count, int c, PhongParams b, MaVec3 normal,
                                  MaVec3 mirror) {
@@ -166,13 +153,26 @@ MA_FN CellMasses storedCellMasses(MA_GLOBAL const float* cells, int count, int c
   return m;
 }
 
-// Pass 2: chunk j's sums into its rows. The C++ reference adds them after pass 1, from
-// the rows (pass 1's loop then has no sum, and a compiler may vectorise it); a
-// work-group's lanes add them as they go.
-MA_FN void setChunkSums(int count, int j, CellMasses sums, MA_LOCAL int* rows, int stride) {
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j), sums.f);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j), sums.q);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j), sums.plain);
+// Passes 2 and 3, after pass 1 (whose loop then has no sum, and a compiler may
+// vectorise it), add each chunk's f, p_ρ, plain and eq. 6 masses into its rows. They
+// run over the cells in order, first the K cells 0 … K − 1 (one of each chunk), then
+// K … 2K − 1, …: each chunk's sum adds its cells as a loop over the chunk would, and
+// the K sums of a turn lie side by side, so that a compiler may vectorise across them.
+MA_FN void zeroChunkSums(int count, MA_LOCAL int* rows, int stride) {
+  for (int r = MA_CHUNK_ROW(count, 0, 0); r < MA_CHUNK_ROW(count, CHUNK_SUMS, 0); ++r)
+    setRowFloat(rows, stride, r, 0.0f);
+}
+
+// The chunks that cells first … first + K − 1 hold.
+MA_FN int chunksFrom(int count, int first) { return count - first < MA_PIXEL_CHUNKS ? count - first : MA_PIXEL_CHUNKS; }
+
+MA_FN void addToChunkSums(int count, int j, CellMasses m, MA_LOCAL int* rows, int stride) {
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j),
+              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j)) + m.f);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j),
+              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j)) + m.q);
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j),
+              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j)) + m.plain);
 }
 
 MA_FN float chunkTotal(MA_LOCAL const int* rows, int stride, int count, int sum) {
@@ -207,10 +207,10 @@ MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, Pixe
   return eq6Value(rowFloat(rows, stride, MA_F_ROW(count, c)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
 }
 
-// Pass 3: eq. 6's terms added per chunk, in pass 1's order; chunk j's Σ then goes to
-// its row.
-MA_FN void setChunkEq6(int count, int j, float mass, MA_LOCAL int* rows, int stride) {
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j), mass);
+// Pass 3: eq. 6's term added to its chunk's sum.
+MA_FN void addToChunkEq6(int count, int j, float term, MA_LOCAL int* rows, int stride) {
+  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j),
+              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)) + term);
 }
 
 // The table: (1 − d) eq. 6 / Σ eq. 6 + d plain / Σ plain, or the plain pdf alone where
@@ -286,16 +286,25 @@ MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_
 
 MA_FN int cdfEntryRow(int count, int p, int product) { return cdfFirstRow(count, product) + p + 1; }
 
+// Three loops over the chunk's entries, each row holding in turn the cell's table
+// mass, the partial sum up to it and its entry: only the second carries a value from
+// cell to cell, and a compiler may vectorise the other two.
 MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
                                 int product, MA_LOCAL int* rows, int stride) {
   float offset = chunkCdfOffset(rows, stride, count, j, t, s, product);
   float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset), partial = 0.0f;
-  for (int i = 0; i < chunkLength(count, j); ++i) {
+  int first = chunkStart(count, j), length = chunkLength(count, j), row = cdfEntryRow(count, first, product);
+  for (int i = 0; i < length; ++i) {
     int c = i * MA_PIXEL_CHUNKS + j;
-    int p = chunkStart(count, j) + i;
-    partial += cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
-    setRowFloat(rows, stride, cdfEntryRow(count, p, product), chunkCdfEntry(count, p, offset, partial, next));
+    setRowFloat(rows, stride, row + i,
+                cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN)));
   }
+  for (int i = 0; i < length; ++i) {
+    partial += rowFloat(rows, stride, row + i);
+    setRowFloat(rows, stride, row + i, partial);
+  }
+  for (int i = 0; i < length; ++i)
+    setRowFloat(rows, stride, row + i, chunkCdfEntry(count, first + i, offset, rowFloat(rows, stride, row + i), next));
   if (j == 0) setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
 }
 
@@ -345,22 +354,18 @@ MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int 
 // The whole build by one work-item (the C++ reference): the pixel's CDF over `count`
 // cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
 // `shareColumns`, the share columns' scales too; with `productCdf`, the product's CDF.
-// samplePixelStage runs the same passes shared among its lanes (buildPixelCdfInLanes).
+// Both kernels call it, one pixel a work-item.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
                                 float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
-    CellMasses sums = zeroCellMasses();
-    for (int i = 0; i < chunkLength(count, j); ++i)
-      addCellMasses(&sums, storedCellMasses(cells, count, i * MA_PIXEL_CHUNKS + j, rows, stride));
-    setChunkSums(count, j, sums, rows, stride);
-  }
+  zeroChunkSums(count, rows, stride);
+  for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
+    for (int j = 0; j < chunksFrom(count, first); ++j)
+      addToChunkSums(count, j, storedCellMasses(cells, count, first + j, rows, stride), rows, stride);
   PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
-    float mass = 0.0f;
-    for (int i = 0; i < chunkLength(count, j); ++i) mass += eq6Term(rows, stride, count, i * MA_PIXEL_CHUNKS + j, t);
-    setChunkEq6(count, j, mass, rows, stride);
-  }
+  for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
+    for (int j = 0; j < chunksFrom(count, first); ++j)
+      addToChunkEq6(count, j, eq6Term(rows, stride, count, first + j, t), rows, stride);
   if (shareColumns) pixelOptimalShareScales(count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
   if (productCdf) {

@@ -16,7 +16,7 @@
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
 // weights, from per-pixel coefficients, an argument of their own), MA_LOCAL_SIZE, and for
-// samplePixelStage MA_PIXEL_LANES (0: no such kernel) with MA_SPLIT_LOAD64.
+// samplePixelStage MA_PIXEL_LANES (0: no such kernel) with MA_GROUP_PIXELS and MA_SPLIT_LOAD64.
 // Constants fold the unused techniques, sampler, estimator and statistics away.
 //
 // No contraction of a*b + c into fma but where the code says fma: the C++ reference is
@@ -323,13 +323,15 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 }
 
 #if MA_PIXEL_LANES > 0 && MA_STATS == 0 && !MA_STORE_SAMPLES
-// The same stage on a CPU, one work-group of MA_PIXEL_LANES (the float vector width)
-// per pixel: lane l takes samples l, L + l, 2L + l, ... of each technique, so that PoCL
-// vectorises across a pixel's samples. Nothing 64-bit is loaded, stored or carried in
-// the sample loop, which would cap LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10):
-// each sample's terms go to local memory in float, and lane 0 adds a chunk of them in
-// the C++ reference's order (addContribution), which keeps the sums bit for bit its sums.
-// Statistics and stored samples stay with sampleStage.
+// The same stage on a CPU, a work-group of L = MA_PIXEL_LANES lanes (the float vector
+// width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not fit
+// local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l builds pixel l's table (the C++
+// reference's buildPixelOptimalCdf): the lanes read each cell at one address, and PoCL vectorises the build's first
+// pass across cells. Then the lanes sample the pixels one at a time: lane l takes samples l, L + l, 2L + l, ... of each
+// technique, so that PoCL vectorises across a pixel's samples. Nothing 64-bit is loaded, stored or carried in the
+// sample loop, which would cap LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10): each sample's terms go to local
+// memory in float, and lane 0 adds a chunk of them in the C++ reference's order (addContribution), which keeps the sums
+// bit for bit its sums. Statistics and stored samples stay with sampleStage.
 //
 // The pixel's rows two words apart: LLVM's SLP vectoriser loads adjacent rows (the
 // normal's x, y, z) as 2-wide vectors and pairs the terms of its basis, which keeps the
@@ -354,166 +356,92 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
   *pixelSums = sums;
 }
 
+// What the sample loop reads of the work-group's pixel q, copied from its rows in
+// groupRows to pixelRows (row r at r·PIXEL_ROW_STRIDE): its inputs and the CDFs it
+// searches. q is kept per lane across the barriers, so that rows read at q would be
+// gathers, and the sample loop would run 4 wide on AVX2 (rule 10).
 #if MA_PIXEL_CELLS > 0
-#if MA_PIXEL_CHUNKS % MA_PIXEL_LANES != 0
-#error "each lane takes whole chunks of the per-pixel table"
+#define SAMPLED_ROWS \
+  (ROW_PIXEL_CDF + (MA_PRODUCT_CELLS ? MA_PRODUCT_CDF_ROW(MA_PIXEL_CELLS, MA_PIXEL_CELLS + 1) : MA_PIXEL_CELLS + 1))
+#else
+#define SAMPLED_ROWS ROW_COUNT
 #endif
-#define CHUNKS_PER_LANE (MA_PIXEL_CHUNKS / MA_PIXEL_LANES)
-// buildPixelOptimalCdf's passes, each shared among the lanes in turns: turn i takes each
-// chunk's i-th cell, lane l chunks l, L + l, ... (L divides the chunks), whose sums and
-// CDF entries it alone writes. A barrier closes each turn, so that PoCL runs a turn
-// across the lanes (docs/pocl.md, rule 1) and compiles one turn, not one copy of the
-// lobe's exp and log per cell. What a turn carries to the next is plain floats, and its
-// cell (iK) xor j, which is iK + j: a struct kept across a barrier stays a short vector
-// (rule 11), and iK + j becomes a 64-bit induction variable, which PoCL keeps per lane
-// (rule 10); either made the turns 3× slower. A background pixel builds its table too;
-// nothing reads it.
-#define CHUNK_TURNS ((MA_PIXEL_CELLS + MA_PIXEL_CHUNKS - 1) / MA_PIXEL_CHUNKS)
-#define CELL_EXISTS(c) (MA_PIXEL_CELLS % MA_PIXEL_CHUNKS == 0 || (c) < MA_PIXEL_CELLS)
 
-// Row r of cell c, or chunk j's spare row past the last cell: the stores stay
-// unconditional (rule 9). A lane past the last cell reads cell 0's rows, and adds 0.
-MA_FN int laneCellRow(int r, int c, int j) { return CELL_EXISTS(c) ? r : MA_SPARE_ROW(MA_PIXEL_CELLS, j); }
-MA_FN int laneReadCell(int c) { return CELL_EXISTS(c) ? c : 0; }
+// Each pixel's rows in a block of ROW_BLOCK words, a power of two: its row r at
+// (q·ROW_BLOCK) xor r, which is q·ROW_BLOCK + r, and leaves LLVM no 64-bit q (rule 10).
+#define ROW_BLOCK MA_ROW_BLOCK(ROW_COUNT)
 
-// Pass 4's CDF entries, the envmap's or the product's, in turns; the last turn's barrier
-// ends the build.
-MA_FN void chunkCdfsInLanes(__global const float* cells, PixelOptimalTerms t, PixelTableScales s, int product,
-                            __local int* rows, int lid) {
-  float offset[CHUNKS_PER_LANE], next[CHUNKS_PER_LANE], partial[CHUNKS_PER_LANE];
-  MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-    int j = h * MA_PIXEL_LANES + lid;
-    offset[h] = chunkCdfOffset(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, j, t, s, product);
-    next[h] = chunkCdfNext(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, j, t, s, product, offset[h]);
-    partial[h] = 0.0f;
-  }
-  if (lid == 0) setRowFloat(rows, PIXEL_ROW_STRIDE, cdfFirstRow(MA_PIXEL_CELLS, product), 0.0f);
-  for (int i = 0; i < CHUNK_TURNS; ++i) {
-    MA_UNROLL
-    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j, r = laneReadCell(c);
-      float mass = cellTableMass(s, eq6Term(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, r, t),
-                                 cellField(cells, MA_PIXEL_CELLS, r, CELL_PLAIN));
-      partial[h] += CELL_EXISTS(c) ? mass : 0.0f;
-      int p = cdfPositionOfCell(MA_PIXEL_CELLS, c);
-      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(cdfEntryRow(MA_PIXEL_CELLS, p, product), c, j),
-                  chunkCdfEntry(MA_PIXEL_CELLS, p, offset[h], partial[h], next[h]));
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-}
-
-// The lanes add their chunks' sums as they go (the C++ reference adds them after pass 1,
-// in the same order), and read the pixel's inputs anew in each turn.
-MA_FN void buildPixelCdfInLanes(__local int* pixelRows, __global const float* cells, int stageSamples, int lid) {
-  __local int* rows = pixelRows + ROW_PIXEL_CDF * PIXEL_ROW_STRIDE;
-  float sumF[CHUNKS_PER_LANE], sumQ[CHUNKS_PER_LANE], sumPlain[CHUNKS_PER_LANE];
-  MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h) sumF[h] = sumQ[h] = sumPlain[h] = 0.0f;
-  for (int i = 0; i < CHUNK_TURNS; ++i) {
-    PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
-    MA_UNROLL
-    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-      int j = h * MA_PIXEL_LANES + lid, c = (i * MA_PIXEL_CHUNKS) ^ j;
-      CellMasses m = zeroCellMasses();
-      if (CELL_EXISTS(c)) m = pixelCellMasses(cells, MA_PIXEL_CELLS, c, in.brdf, in.normal, in.mirror);
-      sumF[h] += m.f;
-      sumQ[h] += m.q;
-      sumPlain[h] += m.plain;
-      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(MA_F_ROW(MA_PIXEL_CELLS, c), c, j), m.f);
-      setRowFloat(rows, PIXEL_ROW_STRIDE, laneCellRow(MA_BRDF_ROW(MA_PIXEL_CELLS, c), c, j), m.q);
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-    CellMasses sums;
-    sums.f = sumF[h];
-    sums.q = sumQ[h];
-    sums.plain = sumPlain[h];
-    setChunkSums(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, sums, rows, PIXEL_ROW_STRIDE);
-  }
+MA_FN int copySampledRows(__local int* pixelRows, __local const int* groupRows, __global const int* pixelOrder,
+                          int first, int q, int lid) {
+  for (int r = lid; r < SAMPLED_ROWS; r += MA_PIXEL_LANES)
+    pixelRows[r * PIXEL_ROW_STRIDE] = groupRows[(q * ROW_BLOCK) ^ r];
+  if (lid == 0) pixelRows[SAMPLED_ROWS * PIXEL_ROW_STRIDE] = pixelOrder[first ^ q];
   barrier(CLK_LOCAL_MEM_FENCE);
-  PixelCdfInputs in = pixelCdfInputs(pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples);
-  PixelOptimalTerms t = pixelOptimalTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, in.envmapShare);
-  float mass[CHUNKS_PER_LANE];
-  MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h) mass[h] = 0.0f;
-  for (int i = 0; i < CHUNK_TURNS; ++i) {
-    MA_UNROLL
-    for (int h = 0; h < CHUNKS_PER_LANE; ++h) {
-      int c = (i * MA_PIXEL_CHUNKS) ^ (h * MA_PIXEL_LANES + lid);
-      float eq6 = eq6Term(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, laneReadCell(c), t);
-      mass[h] += CELL_EXISTS(c) ? eq6 : 0.0f;
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  MA_UNROLL
-  for (int h = 0; h < CHUNKS_PER_LANE; ++h)
-    setChunkEq6(MA_PIXEL_CELLS, h * MA_PIXEL_LANES + lid, mass[h], rows, PIXEL_ROW_STRIDE);
-  barrier(CLK_LOCAL_MEM_FENCE);
-  PixelTableScales s = pixelTableScales(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS, t);
-#if MA_PRODUCT_CELLS
-  ProductCdfTerms p = productCdfTerms(rows, PIXEL_ROW_STRIDE, MA_PIXEL_CELLS);
-  chunkCdfsInLanes(cells, p.t, p.s, 1, rows, lid);
-#endif
-  chunkCdfsInLanes(cells, t, s, 0, rows, lid);
+  return pixelRows[SAMPLED_ROWS * PIXEL_ROW_STRIDE];
 }
-#endif
 
 __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void samplePixelStage(MA_SAMPLE_STAGE_PARAMETERS) {
-  __local int pixelRows[ROW_COUNT * PIXEL_ROW_STRIDE];
+  __local int groupRows[ROW_BLOCK * MA_GROUP_PIXELS];
+  __local int pixelRows[(SAMPLED_ROWS + 1) * PIXEL_ROW_STRIDE];
   __local float terms[TERM_COUNT * CHUNK_SAMPLES];
   __local PixelSums pixelSums;
-  int lid = (int)get_local_id(0);
-  int pixel = pixelOrder[get_group_id(0)];
-  if (lid == 0) {
-    loadPixelRows(pixelRows, PIXEL_ROW_STRIDE, 0, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
-                  productWords, stageSamples, pixel);
-    pixelSums = zeroPixelSums();
+  int lid = (int)get_local_id(0), first = (int)get_group_id(0) * MA_GROUP_PIXELS;
+  int pixels = min(MA_GROUP_PIXELS, pixelCount - first);
+  // Lane l loads pixel l of the work-group and builds its table as the C++ reference
+  // does: the lanes build their tables side by side, each reading the cells at the same
+  // addresses.
+  if (lid < pixels) {
+    loadPixelRows(groupRows, 1, lid * ROW_BLOCK, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
+                  productWords, stageSamples, pixelOrder[first + lid]);
+#if MA_PIXEL_CELLS > 0
+    PixelCdfInputs in = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples);
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, 0, MA_PRODUCT_CELLS,
+                         groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
+#endif
   }
   barrier(CLK_LOCAL_MEM_FENCE);
-#if MA_PIXEL_CELLS > 0
-  buildPixelCdfInLanes(pixelRows, blockProbs, stageSamples, lid);
-#endif
-  MA_UNROLL
-  for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
-    int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
-                          : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
-    for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
-      int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
-      for (int p = 0; p < passes; ++p) {
-        // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
-        int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
-        SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                             width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0, stageSamples,
-                                             seedLo, seedHi, firstPixel, pixel, k, jk);
-        terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
-        terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
-        terms[TERM_B * CHUNK_SAMPLES + t] = c.b;
-        terms[TERM_W * CHUNK_SAMPLES + t] = c.w;
-        if (MA_ONE_SAMPLE) terms[TERM_TECHNIQUE * CHUNK_SAMPLES + t] = as_float(c.technique);
-        barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across samples
+  for (int q = 0; q < pixels; ++q) {
+    int pixel = copySampledRows(pixelRows, groupRows, pixelOrder, first, q, lid);
+    if (lid == 0) pixelSums = zeroPixelSums();
+    MA_UNROLL
+    for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
+      int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
+                            : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
+      for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
+        int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
+        for (int p = 0; p < passes; ++p) {
+          // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
+          int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
+          SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
+                                               width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0,
+                                               stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+          terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
+          terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
+          terms[TERM_B * CHUNK_SAMPLES + t] = c.b;
+          terms[TERM_W * CHUNK_SAMPLES + t] = c.w;
+          if (MA_ONE_SAMPLE) terms[TERM_TECHNIQUE * CHUNK_SAMPLES + t] = as_float(c.technique);
+          barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across samples
+        }
+        if (lid == 0) addChunk(&pixelSums, terms, min(CHUNK_SAMPLES, n - chunk), k);
+        barrier(CLK_LOCAL_MEM_FENCE);
       }
-      if (lid == 0) addChunk(&pixelSums, terms, min(CHUNK_SAMPLES, n - chunk), k);
-      barrier(CLK_LOCAL_MEM_FENCE);
     }
-  }
-  if (lid == 0) {
-    __global ma_acc* e = estimate + estimateOffset(pixel);
-    e[0] = pixelSums.r;
-    e[1] = pixelSums.g;
-    e[2] = pixelSums.b;
-    __global ma_acc* m = moments + momentsOffset(pixel, MA_TECHNIQUES);
-    m[0] = pixelSums.w0;
-    m[1] = pixelSums.ww0;
-    m[2] = pixelSums.w1;
-    m[3] = pixelSums.ww1;
-    if (MA_TECHNIQUES > 2) {
-      m[4] = pixelSums.w2;
-      m[5] = pixelSums.ww2;
+    if (lid == 0) {
+      __global ma_acc* e = estimate + estimateOffset(pixel);
+      e[0] = pixelSums.r;
+      e[1] = pixelSums.g;
+      e[2] = pixelSums.b;
+      __global ma_acc* m = moments + momentsOffset(pixel, MA_TECHNIQUES);
+      m[0] = pixelSums.w0;
+      m[1] = pixelSums.ww0;
+      m[2] = pixelSums.w1;
+      m[3] = pixelSums.ww1;
+      if (MA_TECHNIQUES > 2) {
+        m[4] = pixelSums.w2;
+        m[5] = pixelSums.ww2;
+      }
     }
+    barrier(CLK_LOCAL_MEM_FENCE);
   }
 }
 #endif

@@ -53,14 +53,22 @@ TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, t
   CHECK(sampleKernelLocalBytes(8, 20, true, 16) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
   // The pixel's rows: BRDF (4), normal (3), mirror direction (3), counts (3), first
   // indices (3); 3M coefficients; 3 product; the optimal pdf per pixel's CDF over its
-  // cells (cells + 1), its scratch (2 × cells), 4 sums and a spare row per chunk of cells
-  // and the share columns' scales; the product's CDF over the same cells (cells + 1).
+  // cells (cells + 1), its scratch (2 × cells), 4 sums per chunk of cells and the share
+  // columns' scales; the product's CDF over the same cells (cells + 1).
   CHECK(kern::pixelRowCount(0, 2, 0, 0, 0) == 16);
   CHECK(kern::pixelRowCount(1, 2, 0, 0, 0) == 22);
   CHECK(kern::pixelRowCount(1, 3, 1, 0, 0) == 28);
-  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0) == 16 + 129 + 256 + 5 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS);
-  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1) == 16 + 129 + 256 + 5 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + 129);
+  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS);
+  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + 129);
   static_assert(kern::SHARE_ROWS == MA_PIXEL_SHARE_ROWS, "the share columns' rows of kernels/pixel_optimal.h");
+  // samplePixelStage: each pixel's rows in a power-of-two block, then one pixel's rows
+  // two words apart (and its index), 5 terms of 8 passes a lane and the sums.
+  CHECK(kern::pixelRowBlock(16) == 256);
+  CHECK(kern::pixelRowBlock(1024) == 1024);
+  CHECK(kern::pixelRowBlock(1025) == 2048);
+  CHECK(kern::pixelRowBlock(1 << 20) == 1 << 20);
+  CHECK(pixelStageLocalBytes(16, 16, 1643) == 16 * 2048 * 4 + 1644 * 2 * 4 + 5 * 8 * 16 * 4 + 16 * 8);
+  CHECK(pixelStageLocalBytes(16, 4, 1643) == 4 * 2048 * 4 + 1644 * 2 * 4 + 5 * 8 * 16 * 4 + 16 * 8);
 }
 
 TEST_CASE("launch shape: a 48 KiB GPU runs 256 work-items with few running sums, fewer with many", "[launch]") {

@@ -67,6 +67,15 @@ size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int
   return size_t(localSize) * ((kern::SUM_COUNT + size_t(statSlots)) * acc + (size_t(pixelRows) + 1) * sizeof(cl_int));
 }
 
+size_t pixelStageLocalBytes(int lanes, int pixels, int pixelRows) {
+  // kernels/sample.cl: TERM_COUNT terms of PASSES_PER_CHUNK passes a lane, PixelSums
+  // at most 16 sums of 8 bytes.
+  constexpr size_t termCount = 5, passesPerChunk = 8, sumsBytes = 16 * sizeof(double);
+  return size_t(pixels) * size_t(kern::pixelRowBlock(pixelRows)) * sizeof(cl_int) +
+         (size_t(pixelRows) + 1) * 2 * sizeof(cl_int) + termCount * passesPerChunk * size_t(lanes) * sizeof(float) +
+         sumsBytes;
+}
+
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,
                             int overrideLocalSize) {
   const std::string kind = limits.cpu ? "CPU" : "GPU";

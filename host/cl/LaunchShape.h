@@ -19,7 +19,8 @@ struct DeviceLimits {
   // it leaves no lane idle. 1 where it does not matter (CPU).
   size_t preferredMultiple = 1;
   // CPU: its native float vector width (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), rounded
-  // down to a power of two: the lanes of samplePixelStage, one pixel per work-group.
+  // down to a power of two: the lanes of samplePixelStage, which samples one pixel at a
+  // time across them.
   // 0 on other devices, which run sampleStage for every stage.
   int pixelLanes = 0;
 };
@@ -36,6 +37,12 @@ DeviceLimits deviceLimits(const cl::Device& device);
 // one-row placeholder that it never touches: PoCL and clang's nvptx64 back end both
 // drop it, so it is not counted.
 size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int pixelRows);
+
+// The local memory of samplePixelStage at `lanes` lanes and `pixels` pixels a
+// work-group: each pixel's rows in a power-of-two block (kern::pixelRowBlock), one
+// pixel's copy for the sample loop, its chunk of sample terms and its sums
+// (kernels/sample.cl).
+size_t pixelStageLocalBytes(int lanes, int pixels, int pixelRows);
 
 struct LaunchShape {
   int localSize = 0;

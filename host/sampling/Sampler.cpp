@@ -51,7 +51,8 @@ void writeVec3(const kern::MaVec3& v, float* w) {
 
 }  // namespace
 
-std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes) {
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes,
+                                int groupPixels) {
   const EnvmapTables& t = scene.tables;
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
@@ -59,7 +60,7 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
       "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_PRODUCT_TABLES={} -DMA_PRODUCT_BLOCK_LOG2={} "
       "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_PRODUCT_CELLS={} -DMA_PIXEL_CELLS={} -DMA_PIXEL_CDF_STEPS={} "
-      "-DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} "
+      "-DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} -DMA_GROUP_PIXELS={} "
       "-DMA_SPLIT_LOAD64={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
       scene.envmap.coskExponent >= 0 ? 1 : 0, t.bankShares, t.blockLog2,
@@ -67,11 +68,19 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
       config.risCandidates, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
       sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0, scene.productTables.tables,
       scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, scene.productTables.pixelCells ? 1 : 0,
-      t.pixelCells, t.pixelCdfSteps, localSize, pixelLanes, pixelLanes > 0 ? 1 : 0);
+      t.pixelCells, t.pixelCdfSteps, localSize, pixelLanes, groupPixels, pixelLanes > 0 ? 1 : 0);
 }
 
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes) {
   return scene.tables.useCdf || config.risCandidates > 0 ? 0 : deviceLanes;
+}
+
+int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes) {
+  const int rows = kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
+                                       scene.tables.pixelCells, scene.productTables.pixelCells);
+  int pixels = lanes;
+  while (pixels > 0 && pixelStageLocalBytes(lanes, pixels, rows) > localMemBytes) pixels /= 2;
+  return pixels;
 }
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
@@ -114,10 +123,14 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
       localSize);
   localSize_ = shape.localSize;
   pixelLanes_ = samplePixelLanes(scene, config, limits.pixelLanes);
+  groupPixels_ = pixelLanes_ > 0 ? pixelStageGroupPixels(scene, config, pixelLanes_, limits.localMemBytes) : 0;
+  if (groupPixels_ == 0) pixelLanes_ = 0;
   share_.launch = shape.why;
   if (pixelLanes_ > 0)
-    share_.launch += fmt::format("; stages without running sums: one pixel per {} lanes", pixelLanes_);
-  const std::string plainOptions = sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_),
+    share_.launch += fmt::format("; stages without running sums: {} pixels a work-group, each across its {} lanes",
+                                 groupPixels_, pixelLanes_);
+  const std::string plainOptions =
+                        sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_, groupPixels_),
                     statisticsOptions = sampleKernelOptions(scene, config, localSize_);
   plainKernel_ =
       cl::Kernel(buildProgram(device, "sample.cl", plainOptions), pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
@@ -201,7 +214,8 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
        cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
-  const size_t global = lanes > 0 ? order.size() * lanes : (order.size() + local - 1) / local * local;
+  const size_t groups = lanes > 0 ? (order.size() + size_t(groupPixels_) - 1) / size_t(groupPixels_) : 0;
+  const size_t global = lanes > 0 ? groups * local : (order.size() + local - 1) / local * local;
   if (global > 0) {
     cl::Event done;
     queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local), nullptr, &done);

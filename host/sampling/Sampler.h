@@ -13,7 +13,8 @@ namespace misalloc {
 // The `-D` options that compile kernels/sample.cl for exactly this scene, estimator,
 // statistics and work-group size; `pixelLanes` > 0 adds samplePixelStage at that many
 // lanes, with 64-bit table reads split in two (docs/pocl.md, rule 10).
-std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes = 0);
+std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes = 0,
+                                int groupPixels = 0);
 
 // The lanes of samplePixelStage for this scene and config on a device whose
 // DeviceLimits::pixelLanes is `deviceLanes` (0: not a CPU), or 0 where the stages keep
@@ -21,6 +22,11 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 // CPU"): the CDF sampler's searches and resampling's candidates ran slower one pixel per
 // work-group.
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes);
+
+// The pixels a work-group of samplePixelStage at `lanes` lanes takes: `lanes`, or the
+// largest smaller power of two whose rows fit `localMemBytes` (pixelStageLocalBytes):
+// a per-pixel table of many cells. 0 where not even one pixel's fit.
+int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes);
 
 // A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
 // that share a context (the sub-devices of one device, cl/Device.h) share one copy, so
@@ -37,9 +43,9 @@ class SceneBuffers {
 };
 
 // Runs kernels/sample.cl on a device: sampleStage, across pixels; on a CPU, stages
-// without running sums run samplePixelStage, one pixel per work-group of its native
-// float width. The program is built and the scene uploaded once; each run() takes one
-// stage for every pixel.
+// without running sums run samplePixelStage, a work-group of its native float width L
+// taking L pixels, one after another, each across its lanes. The program is built and the scene uploaded once; each
+// run() takes one stage for every pixel.
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
@@ -78,7 +84,8 @@ class Sampler : public StageSampler {
 
   const Device& device_;
   int localSize_;
-  int pixelLanes_;  // > 0: plainKernel_ is samplePixelStage
+  int pixelLanes_;   // > 0: plainKernel_ is samplePixelStage
+  int groupPixels_;  // its pixels a work-group
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
   std::shared_ptr<const SceneBuffers> sceneBuffers_;

@@ -104,10 +104,11 @@ std::set<Variant> hostVariants() {
                   variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
                 }
                 // A CPU's plain program with samplePixelStage (Sampler), at AVX2's and
-                // AVX-512's float widths.
+                // AVX-512's float widths, with PoCL's 512 KiB of local memory.
                 for (int deviceLanes : {8, 16})
                   if (const int lanes = samplePixelLanes(s, config, deviceLanes); lanes > 0)
-                    variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), 8, lanes)});
+                    if (const int pixels = pixelStageGroupPixels(s, config, lanes, 512 * 1024); pixels > 0)
+                      variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), 8, lanes, pixels)});
                 if (config.gridSize > 0)
                   variants.insert(
                       {"gridsearch.cl", gridSearchKernelOptions(sampleColumns(s, config), config.optimalWeights)});
