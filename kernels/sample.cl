@@ -133,16 +133,18 @@ MA_FN MaFrame frameOfRows(__local const int* pixelRows, int rowStride, int colum
 #undef ROW_FLOAT
 }
 
-// Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows.
-// The envmap tables are read where the sample falls: they are the gathers that remain.
+// Sample j of `technique`'s samples (one-sample: of the stage), from the pixel's rows
+// and its per-pixel CDFs (row r at cdfRows[r · cdfStride]). The envmap tables are read
+// where the sample falls: they are the gathers that remain.
 // The random numbers are keyed on the image's pixel firstPixel + pixel: a band of an
 // image's rows (host/render/Band.h) draws the samples the whole image's render draws.
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs,
                                        __global const float* productFloats, __global const uint* productWords,
                                        int width, int height, float coskExponent, __local const int* pixelRows,
-                                       int rowStride, int column, int stageSamples, uint seedLo, uint seedHi,
-                                       int firstPixel, int pixel, int technique, int j) {
+                                       int rowStride, int column, __local const int* cdfRows, int cdfStride,
+                                       int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
+                                       int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   EnvmapView env;
   env.texels = texels;
@@ -160,8 +162,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.brdfBin = (int)as_float(PIXEL_ROW(ROW_BRDF_BIN));
   env.bankEntry = 0;
   env.pixelCells = MA_PIXEL_CELLS;
-  env.pixelCdf = pixelRows + (MA_PIXEL_CELLS > 0 ? ROW_PIXEL_CDF * rowStride + column : 0);
-  env.pixelCdfStride = rowStride;
+  env.pixelCdf = cdfRows;
+  env.pixelCdfStride = cdfStride;
   env.pixelCdfSteps = MA_PIXEL_CDF_STEPS;
 
   TechniqueSet ts;
@@ -268,9 +270,10 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
     for (int jk = 0; jk < passSamples; ++jk) {
-      SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width,
-                                           height, coskExponent, pixelRows, MA_LOCAL_SIZE, lid, stageSamples, seedLo,
-                                           seedHi, firstPixel, pixel, k, jk);
+      SampleContribution c =
+          sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width, height,
+                        coskExponent, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
+                        MA_LOCAL_SIZE, stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;
@@ -356,33 +359,34 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
   *pixelSums = sums;
 }
 
-// What the sample loop reads of the work-group's pixel q, copied from its rows in
-// groupRows to pixelRows (row r at r·PIXEL_ROW_STRIDE): its inputs and the CDFs it
-// searches. q is kept per lane across the barriers, so that rows read at q would be
-// gathers, and the sample loop would run 4 wide on AVX2 (rule 10).
-#if MA_PIXEL_CELLS > 0
-#define SAMPLED_ROWS \
-  (ROW_PIXEL_CDF + (MA_PRODUCT_CELLS ? MA_PRODUCT_CDF_ROW(MA_PIXEL_CELLS, MA_PIXEL_CELLS + 1) : MA_PIXEL_CELLS + 1))
-#else
-#define SAMPLED_ROWS ROW_COUNT
-#endif
-
 // Each pixel's rows in a block of ROW_BLOCK words, a power of two: its row r at
 // (q·ROW_BLOCK) xor r, which is q·ROW_BLOCK + r, and leaves LLVM no 64-bit q (rule 10).
 #define ROW_BLOCK MA_ROW_BLOCK(ROW_COUNT)
+// pixelRows: the inputs of the pixel being sampled (its rows before the CDFs'), then
+// its index and its block's first word.
+enum { ROW_SAMPLED_PIXEL = ROW_PIXEL_CDF, ROW_SAMPLED_BLOCK, SAMPLED_ROWS };
 
-MA_FN int copySampledRows(__local int* pixelRows, __local const int* groupRows, __global const int* pixelOrder,
-                          int first, int q, int lid) {
-  for (int r = lid; r < SAMPLED_ROWS; r += MA_PIXEL_LANES)
+// Pixel q of the work-group, to be sampled: its inputs copied to pixelRows (row r at
+// r·PIXEL_ROW_STRIDE), there read at fixed addresses, and its index and block read
+// back from local memory. q is kept per lane across the barriers, and PoCL cannot tell
+// that it is the same in every lane: rows read at q would be gathers, and what the
+// sample loop computes once from the pixel's index (its Philox key, 64-bit products)
+// would be kept per lane and hold the loop to 4 lanes (docs/pocl.md, rule 10). Read
+// back from local memory after the barrier, each is one value for the work-group.
+MA_FN void copySampledPixel(__local int* pixelRows, __local const int* groupRows, __global const int* pixelOrder,
+                            int first, int q, int lid) {
+  for (int r = lid; r < ROW_PIXEL_CDF; r += MA_PIXEL_LANES)
     pixelRows[r * PIXEL_ROW_STRIDE] = groupRows[(q * ROW_BLOCK) ^ r];
-  if (lid == 0) pixelRows[SAMPLED_ROWS * PIXEL_ROW_STRIDE] = pixelOrder[first ^ q];
+  if (lid == 0) {
+    pixelRows[ROW_SAMPLED_PIXEL * PIXEL_ROW_STRIDE] = pixelOrder[first ^ q];
+    pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] = q * ROW_BLOCK;
+  }
   barrier(CLK_LOCAL_MEM_FENCE);
-  return pixelRows[SAMPLED_ROWS * PIXEL_ROW_STRIDE];
 }
 
 __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void samplePixelStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local int groupRows[ROW_BLOCK * MA_GROUP_PIXELS];
-  __local int pixelRows[(SAMPLED_ROWS + 1) * PIXEL_ROW_STRIDE];
+  __local int pixelRows[SAMPLED_ROWS * PIXEL_ROW_STRIDE];
   __local float terms[TERM_COUNT * CHUNK_SAMPLES];
   __local PixelSums pixelSums;
   int lid = (int)get_local_id(0), first = (int)get_group_id(0) * MA_GROUP_PIXELS;
@@ -401,7 +405,9 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   for (int q = 0; q < pixels; ++q) {
-    int pixel = copySampledRows(pixelRows, groupRows, pixelOrder, first, q, lid);
+    copySampledPixel(pixelRows, groupRows, pixelOrder, first, q, lid);
+    int pixel = pixelRows[ROW_SAMPLED_PIXEL * PIXEL_ROW_STRIDE];
+    __local const int* cdfRows = groupRows + pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] + ROW_PIXEL_CDF;
     if (lid == 0) pixelSums = zeroPixelSums();
     MA_UNROLL
     for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
@@ -413,7 +419,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
           // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
           int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
           SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                               width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0,
+                                               width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0, cdfRows, 1,
                                                stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
           terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
           terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
