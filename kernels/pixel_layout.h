@@ -62,6 +62,11 @@ MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int
   return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells);
 }
 
+// samplePixelStage's chunk of sample terms (kernels/sample.cl): per term, a float for
+// each of MA_PASSES_PER_CHUNK passes of its lanes.
+#define MA_PASSES_PER_CHUNK 8
+enum { TERM_R, TERM_G, TERM_B, TERM_W, TERM_TECHNIQUE, TERM_COUNT };
+
 // The words of a pixel's block of rows in samplePixelStage (kernels/sample.cl): the
 // least power of two that holds its `rows` rows, up to 2^20.
 #define MA_ROW_BLOCK(rows)     \

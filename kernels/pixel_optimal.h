@@ -73,6 +73,9 @@ enum {
 
 MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
 MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
+MA_FN void addToRowFloat(MA_LOCAL int* rows, int stride, int r, float v) {
+  setRowFloat(rows, stride, r, rowFloat(rows, stride, r) + v);
+}
 
 typedef struct {
   MaVec3 centre;
@@ -167,12 +170,9 @@ MA_FN void zeroChunkSums(int count, MA_LOCAL int* rows, int stride) {
 MA_FN int chunksFrom(int count, int first) { return count - first < MA_PIXEL_CHUNKS ? count - first : MA_PIXEL_CHUNKS; }
 
 MA_FN void addToChunkSums(int count, int j, CellMasses m, MA_LOCAL int* rows, int stride) {
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j),
-              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j)) + m.f);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j),
-              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j)) + m.q);
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j),
-              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j)) + m.plain);
+  addToRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_F, j), m.f);
+  addToRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_BRDF, j), m.q);
+  addToRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_PLAIN, j), m.plain);
 }
 
 MA_FN float chunkTotal(MA_LOCAL const int* rows, int stride, int count, int sum) {
@@ -209,8 +209,7 @@ MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, Pixe
 
 // Pass 3: eq. 6's term added to its chunk's sum.
 MA_FN void addToChunkEq6(int count, int j, float term, MA_LOCAL int* rows, int stride) {
-  setRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j),
-              rowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j)) + term);
+  addToRowFloat(rows, stride, MA_CHUNK_ROW(count, CHUNK_EQ6, j), term);
 }
 
 // The table: (1 − d) eq. 6 / Σ eq. 6 + d plain / Σ plain, or the plain pdf alone where

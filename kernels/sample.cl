@@ -327,22 +327,23 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 
 #if MA_PIXEL_LANES > 0 && MA_STATS == 0 && !MA_STORE_SAMPLES
 // The same stage on a CPU, a work-group of L = MA_PIXEL_LANES lanes (the float vector
-// width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not fit
-// local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l builds pixel l's table (the C++
-// reference's buildPixelOptimalCdf): the lanes read each cell at one address, and PoCL vectorises the build's first
-// pass across cells. Then the lanes sample the pixels one at a time: lane l takes samples l, L + l, 2L + l, ... of each
-// technique, so that PoCL vectorises across a pixel's samples. Nothing 64-bit is loaded, stored or carried in the
-// sample loop, which would cap LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10): each sample's terms go to local
-// memory in float, and lane 0 adds a chunk of them in the C++ reference's order (addContribution), which keeps the sums
-// bit for bit its sums. Statistics and stored samples stay with sampleStage.
+// width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not
+// fit local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l
+// builds pixel l's table (the C++ reference's buildPixelOptimalCdf): the lanes read
+// each cell at one address, and PoCL vectorises the build's first pass across cells.
+// Then the lanes sample the pixels one at a time: lane l takes samples l, L + l,
+// 2L + l, ... of each technique, so that PoCL vectorises across a pixel's samples.
+// Nothing 64-bit is loaded, stored or carried in the sample loop, which would cap
+// LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10): each sample's terms go to local
+// memory in float, and lane 0 adds a chunk of them in the C++ reference's order
+// (addContribution), which keeps the sums bit for bit its sums. Statistics and stored
+// samples stay with sampleStage.
 //
 // The pixel's rows two words apart: LLVM's SLP vectoriser loads adjacent rows (the
 // normal's x, y, z) as 2-wide vectors and pairs the terms of its basis, which keeps the
 // sample loop scalar (docs/pocl.md, rule 8): twice the time of the whole stage.
 #define PIXEL_ROW_STRIDE 2
-#define PASSES_PER_CHUNK 8
-#define CHUNK_SAMPLES (PASSES_PER_CHUNK * MA_PIXEL_LANES)
-enum { TERM_R, TERM_G, TERM_B, TERM_W, TERM_TECHNIQUE, TERM_COUNT };
+#define CHUNK_SAMPLES (MA_PASSES_PER_CHUNK * MA_PIXEL_LANES)
 
 // Adds terms [0, count) of a chunk of technique k's samples (one-sample: each term's own).
 MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, int count, int k) {
@@ -414,7 +415,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
       int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
                             : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
       for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
-        int passes = min(PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
+        int passes = min(MA_PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
         for (int p = 0; p < passes; ++p) {
           // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
           int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;

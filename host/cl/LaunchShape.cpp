@@ -68,12 +68,12 @@ size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int
 }
 
 size_t pixelStageLocalBytes(int lanes, int pixels, int pixelRows) {
-  // kernels/sample.cl: TERM_COUNT terms of PASSES_PER_CHUNK passes a lane, PixelSums
-  // at most 16 sums of 8 bytes.
-  constexpr size_t termCount = 5, passesPerChunk = 8, sumsBytes = 16 * sizeof(double);
+  // Bounds for the sampled pixel's copy (fewer rows than the pixel's, two words apart)
+  // and PixelSums (at most 16 sums of 8 bytes).
+  constexpr size_t sumsBytes = 16 * sizeof(double);
   return size_t(pixels) * size_t(kern::pixelRowBlock(pixelRows)) * sizeof(cl_int) +
-         (size_t(pixelRows) + 1) * 2 * sizeof(cl_int) + termCount * passesPerChunk * size_t(lanes) * sizeof(float) +
-         sumsBytes;
+         (size_t(pixelRows) + 1) * 2 * sizeof(cl_int) +
+         size_t(kern::TERM_COUNT) * MA_PASSES_PER_CHUNK * size_t(lanes) * sizeof(float) + sumsBytes;
 }
 
 LaunchShape chooseLocalSize(const DeviceLimits& limits, const std::function<size_t(int)>& localBytes,

@@ -39,9 +39,9 @@ DeviceLimits deviceLimits(const cl::Device& device);
 size_t sampleKernelLocalBytes(int localSize, int statSlots, bool doubleSums, int pixelRows);
 
 // The local memory of samplePixelStage at `lanes` lanes and `pixels` pixels a
-// work-group: each pixel's rows in a power-of-two block (kern::pixelRowBlock), one
-// pixel's copy for the sample loop, its chunk of sample terms and its sums
-// (kernels/sample.cl).
+// work-group, at most: each pixel's rows in a power-of-two block (kern::pixelRowBlock),
+// the sampled pixel's inputs for the sample loop, its chunk of sample terms and its
+// sums (kernels/sample.cl).
 size_t pixelStageLocalBytes(int lanes, int pixels, int pixelRows);
 
 struct LaunchShape {

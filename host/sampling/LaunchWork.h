@@ -37,8 +37,8 @@ struct LaunchWork {
 
 // `groupSize` 1: a sampler that runs each pixel's counts alone (HostSampler).
 // `pixelLanes` > 0: pixels sampled one at a time by a work-group of that many lanes
-// (samplePixelStage), which runs each technique's n_k rounded up to a multiple of the lanes; the one-sample
-// estimator, N rounded up, shared by the counts' expectation.
+// (samplePixelStage), which runs each technique's n_k rounded up to a multiple of the
+// lanes; the one-sample estimator, N rounded up, shared by the counts' expectation.
 LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize, int pixelLanes = 0);
 
 }  // namespace misalloc

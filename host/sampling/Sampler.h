@@ -44,8 +44,8 @@ class SceneBuffers {
 
 // Runs kernels/sample.cl on a device: sampleStage, across pixels; on a CPU, stages
 // without running sums run samplePixelStage, a work-group of its native float width L
-// taking L pixels, one after another, each across its lanes. The program is built and the scene uploaded once; each
-// run() takes one stage for every pixel.
+// taking L pixels, one after another, each across its lanes. The program is built and
+// the scene uploaded once; each run() takes one stage for every pixel.
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
