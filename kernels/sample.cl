@@ -214,6 +214,19 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
 #undef PIXEL_ROW
 }
 
+// Stores sample c of the pixel in slot i (kernels/stats.h), or, where it is not `kept`,
+// in the lane's spare record: every lane stores, unmasked.
+MA_FN void storeSample(__global float* samples, SampleContribution c, int kept, int pixel, int i, int sampleCapacity,
+                       int spareSamples, int lane) {
+#define STORED_AT(q) \
+  (kept ? storedSampleIndex(pixel, i, (q), sampleCapacity, SAMPLE_COLUMNS) : spareSampleIndex(spareSamples, (q), lane))
+  samples[STORED_AT(0)] = (float)storedColumn(c, MA_SHARE_COLUMNS);
+  samples[STORED_AT(1)] = storedSampleValue(MA_STATS, c);
+  MA_UNROLL
+  for (int l = 0; l < SAMPLE_COLUMNS; ++l) samples[STORED_AT(2 + l)] = storedPdf(c, MA_SHARE_COLUMNS, l);
+#undef STORED_AT
+}
+
 // The arguments of both sampling kernels: the host binds them once (Sampler::runPixels).
 // --weights optimal: a_{c,k} at coefficientsOffset(pixel, M) + c·M + k (kernels/pixel_layout.h).
 #if MA_OPTIMAL_WEIGHTS
@@ -293,16 +306,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
         running[s][lid] +=
             counted && c.technique == s / perTechnique ? statValue(MA_STATS, MA_TECHNIQUES, s % perTechnique, c) : 0;
       }
-      if (MA_STORE_SAMPLES) {
-        int kept = counted && gid < pixelCount, i = firstSlot + j;
-#define STORED_AT(q) \
-  (kept ? storedSampleIndex(pixel, i, (q), sampleCapacity, SAMPLE_COLUMNS) : spareSampleIndex(spareSamples, (q), lid))
-        samples[STORED_AT(0)] = (float)storedColumn(c, MA_SHARE_COLUMNS);
-        samples[STORED_AT(1)] = storedSampleValue(MA_STATS, c);
-        MA_UNROLL
-        for (int l = 0; l < SAMPLE_COLUMNS; ++l) samples[STORED_AT(2 + l)] = storedPdf(c, MA_SHARE_COLUMNS, l);
-#undef STORED_AT
-      }
+      if (MA_STORE_SAMPLES)
+        storeSample(samples, c, counted && gid < pixelCount, pixel, firstSlot + j, sampleCapacity, spareSamples, lid);
       barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
     }
     start += n;
@@ -325,7 +330,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   }
 }
 
-#if MA_PIXEL_LANES > 0 && MA_STATS == 0 && !MA_STORE_SAMPLES
+#if MA_PIXEL_LANES > 0 && MA_STATS == 0
 // The same stage on a CPU, a work-group of L = MA_PIXEL_LANES lanes (the float vector
 // width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not
 // fit local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l
@@ -336,8 +341,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 // Nothing 64-bit is loaded, stored or carried in the sample loop, which would cap
 // LLVM's width at 4 on AVX2 (docs/pocl.md, rule 10): each sample's terms go to local
 // memory in float, and lane 0 adds a chunk of them in the C++ reference's order
-// (addContribution), which keeps the sums bit for bit its sums. Statistics and stored
-// samples stay with sampleStage.
+// (addContribution), which keeps the sums bit for bit its sums. Each lane stores its own
+// samples (MA_STORE_SAMPLES, exact's pilot); running sums stay with sampleStage.
 //
 // The pixel's rows two words apart: LLVM's SLP vectoriser loads adjacent rows (the
 // normal's x, y, z) as 2-wide vectors and pairs the terms of its basis, which keeps the
@@ -400,8 +405,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
                   productWords, stageSamples, pixelOrder[first + lid]);
 #if MA_PIXEL_CELLS > 0
     PixelCdfInputs in = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples);
-    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, 0, MA_PRODUCT_CELLS,
-                         groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare,
+                         MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
 #endif
   }
   barrier(CLK_LOCAL_MEM_FENCE);
@@ -410,6 +415,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
     int pixel = pixelRows[ROW_SAMPLED_PIXEL * PIXEL_ROW_STRIDE];
     __local const int* cdfRows = groupRows + pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] + ROW_PIXEL_CDF;
     if (lid == 0) pixelSums = zeroPixelSums();
+    int start = 0;  // the technique's first sample in the stage
     MA_UNROLL
     for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
       int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
@@ -427,11 +433,14 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
           terms[TERM_B * CHUNK_SAMPLES + t] = c.b;
           terms[TERM_W * CHUNK_SAMPLES + t] = c.w;
           if (MA_ONE_SAMPLE) terms[TERM_TECHNIQUE * CHUNK_SAMPLES + t] = as_float(c.technique);
+          if (MA_STORE_SAMPLES)
+            storeSample(samples, c, jk < n, pixel, firstSlot + start + jk, sampleCapacity, spareSamples, lid);
           barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across samples
         }
         if (lid == 0) addChunk(&pixelSums, terms, min(CHUNK_SAMPLES, n - chunk), k);
         barrier(CLK_LOCAL_MEM_FENCE);
       }
+      start += n;
     }
     if (lid == 0) {
       __global ma_acc* e = estimate + estimateOffset(pixel);

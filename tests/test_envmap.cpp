@@ -578,9 +578,9 @@ TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables
   // nearest it (kernels/stats.h's share columns), which pixelSharePdfs evaluates from
   // scales kept beside the stage's own table. At every texel, each must be the pdf of the
   // table that a stage of that share builds, up to the rounding of that table's CDF
-  // entries to the uniform's grid and the order of its sums: a cell's probability within
-  // 8 steps of the grid, as the product's test above bounds it (32 × 16 cells, 32 to a
-  // chunk, came within 4.1 steps; 16 × 8 within 4).
+  // entries to the uniform's grid (the scales sum eq. 6 in the stage's order): a cell's
+  // probability within 8 steps of the grid, as the product's test above bounds it
+  // (32 × 16 cells, 32 to a chunk, came within 4.1 steps; 16 × 8 within 4).
   for (const auto& [name, map] : testMaps()) {
     EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
     if (tables.pixelCells == 0) continue;  // the black map's plain tables

@@ -109,8 +109,9 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
     HostSampler host(scene, config);
     size_t mismatches = 0;
     // Two stages, so that the running sums and stored samples carry over, and a last
-    // stage without them (on a CPU with the alias sampler, samplePixelStage) whose
-    // counts span several of its chunks of terms.
+    // stage without them whose counts span several of samplePixelStage's chunks of
+    // terms. On a CPU with the alias sampler samplePixelStage runs every stage but those
+    // that keep running sums: the stored samples of the share columns' config too.
     for (int stage = 0; stage < 3; ++stage) {
       const int scale = stage == 2 ? 3 : 1;
       StagePlan s = plan;

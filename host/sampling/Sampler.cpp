@@ -125,17 +125,21 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   pixelLanes_ = samplePixelLanes(scene, config, limits.pixelLanes);
   groupPixels_ = pixelLanes_ > 0 ? pixelStageGroupPixels(scene, config, pixelLanes_, limits.localMemBytes) : 0;
   if (groupPixels_ == 0) pixelLanes_ = 0;
+  // Stored samples need no running sums: exact's pilot runs samplePixelStage too.
+  statisticsLanes_ = config.statsMask == 0 ? pixelLanes_ : 0;
   share_.launch = shape.why;
   if (pixelLanes_ > 0)
     share_.launch += fmt::format("; stages without running sums: {} pixels a work-group, each across its {} lanes",
                                  groupPixels_, pixelLanes_);
   const std::string plainOptions =
                         sampleKernelOptions(scene, plainConfig(config), localSize_, pixelLanes_, groupPixels_),
-                    statisticsOptions = sampleKernelOptions(scene, config, localSize_);
-  plainKernel_ =
-      cl::Kernel(buildProgram(device, "sample.cl", plainOptions), pixelLanes_ > 0 ? "samplePixelStage" : "sampleStage");
-  kernel_ = keepsStatistics(config) ? cl::Kernel(buildProgram(device, "sample.cl", statisticsOptions), "sampleStage")
-                                    : plainKernel_;
+                    statisticsOptions = sampleKernelOptions(scene, config, localSize_, statisticsLanes_,
+                                                            statisticsLanes_ > 0 ? groupPixels_ : 0);
+  auto kernelFor = [](int lanes) { return lanes > 0 ? "samplePixelStage" : "sampleStage"; };
+  plainKernel_ = cl::Kernel(buildProgram(device, "sample.cl", plainOptions), kernelFor(pixelLanes_));
+  kernel_ = keepsStatistics(config)
+                ? cl::Kernel(buildProgram(device, "sample.cl", statisticsOptions), kernelFor(statisticsLanes_))
+                : plainKernel_;
   launchIdentity_ = fmt::format("{}, driver {}, {} compute units; kernel sources {:016x}; {}; {}", device.name(),
                                 device.device.getInfo<CL_DRIVER_VERSION>(),
                                 device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), embeddedSourcesHash(),

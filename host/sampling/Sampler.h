@@ -43,9 +43,10 @@ class SceneBuffers {
 };
 
 // Runs kernels/sample.cl on a device: sampleStage, across pixels; on a CPU, stages
-// without running sums run samplePixelStage, a work-group of its native float width L
-// taking L pixels, one after another, each across its lanes. The program is built and
-// the scene uploaded once; each run() takes one stage for every pixel.
+// without running sums (with or without stored samples) run samplePixelStage, a
+// work-group of its native float width L taking L pixels, one after another, each
+// across its lanes. The program is built and the scene uploaded once; each run() takes
+// one stage for every pixel.
 class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
@@ -68,7 +69,7 @@ class Sampler : public StageSampler {
   std::vector<DeviceShare> deviceShares() const override;
   std::string launchIdentity() const override { return launchIdentity_; }
   int launchGroupSize() const override { return localSize_; }
-  int pixelLanes(bool keepsStatistics) const override { return keepsStatistics ? 0 : pixelLanes_; }
+  int pixelLanes(bool keepsStatistics) const override { return keepsStatistics ? statisticsLanes_ : pixelLanes_; }
 
  protected:
   void forgetStages() override;
@@ -84,8 +85,9 @@ class Sampler : public StageSampler {
 
   const Device& device_;
   int localSize_;
-  int pixelLanes_;   // > 0: plainKernel_ is samplePixelStage
-  int groupPixels_;  // its pixels a work-group
+  int pixelLanes_;       // > 0: plainKernel_ is samplePixelStage
+  int statisticsLanes_;  // > 0: kernel_ is samplePixelStage too (stored samples, no running sums)
+  int groupPixels_;      // samplePixelStage's pixels a work-group
   bool doubleSums_;
   cl::Kernel kernel_, plainKernel_;  // with the config's statistics, and without (plainConfig)
   std::shared_ptr<const SceneBuffers> sceneBuffers_;

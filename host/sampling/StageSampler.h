@@ -41,9 +41,9 @@ class StageSampler : public StageStatistics, public DeviceReport {
 
   // The pixels that run a technique's loop together: a work-group (Sampler).
   virtual int launchGroupSize() const { return 1; }
-  // > 0: the stages with (`keepsStatistics`) or without running sums sample one pixel at
-  // a time across a work-group of this many lanes (Sampler on a CPU, kernels/sample.cl
-  // samplePixelStage).
+  // > 0: the stages that keep statistics (`keepsStatistics`: running sums or stored
+  // samples) or those that keep none sample one pixel at a time across a work-group of
+  // this many lanes (Sampler on a CPU, kernels/sample.cl samplePixelStage).
   virtual int pixelLanes(bool /*keepsStatistics*/) const { return 0; }
 
  protected:
