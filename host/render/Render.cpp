@@ -51,11 +51,17 @@ void accumulateStage(StageTotals& totals, const TakenStage& stage, Estimator est
 
 }  // namespace
 
+int pilotSamples(double pilotFraction, int spp, int techniqueCount) {
+  const int pilot = std::max(2 * techniqueCount, int(std::lround(pilotFraction * spp)));
+  const int pass = techniqueCount * kPilotLanes, filled = (pilot + pass - 1) / pass * pass;
+  return filled <= spp / 4 ? filled : pilot;
+}
+
 std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount) {
   if (!(pilotFraction > 0 && pilotFraction < 1))
     throw InputError(fmt::format("--pilot {}: the pilot's share of the budget must lie in (0, 1)", pilotFraction));
   if (stages < 1) throw InputError(fmt::format("--stages {}: need at least one stage after the pilot", stages));
-  int pilot = std::max(2 * techniqueCount, int(std::lround(pilotFraction * spp)));
+  const int pilot = pilotSamples(pilotFraction, spp, techniqueCount);
   if (spp < pilot + stages)
     throw InputError(
         fmt::format("--spp {} is smaller than the pilot ({} samples: at least 2 per technique) plus {} "
@@ -160,13 +166,16 @@ std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
 }
 
 // The largest stage that keeps statistics (all but the last) whatever the technique
-// count M, which the sampler config does not know: the pilot takes max(2M, f·N) ≤
-// max(2·kMaxTechniques, f·N) samples, and the stages after it are largest after the
-// smallest pilot, that of M = 2.
+// count M, which the sampler config does not know: the largest of the pilots of every
+// M, and of the stages after the pilot of M = 2, which are largest after the smallest
+// pilot.
 int largestStatisticsStage(const AdaptiveOptions& options, int spp) {
   std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, 2);
   sizes.pop_back();
-  return std::max(*std::max_element(sizes.begin(), sizes.end()), std::min(spp, 2 * kMaxTechniques));
+  int largest = *std::max_element(sizes.begin(), sizes.end());
+  for (int M = 2; M <= kMaxTechniques; ++M)
+    largest = std::max(largest, std::min(spp, pilotSamples(options.pilotFraction, spp, M)));
+  return largest;
 }
 
 }  // namespace

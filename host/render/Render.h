@@ -31,7 +31,7 @@ inline constexpr double kDefaultImageGainBelow = 1.0;
 // The batched schedule of the adaptive methods ([HS14] Algorithm 1, Sec. 5.2), and the
 // options of the other methods that take any (oracle, ris).
 struct AdaptiveOptions {
-  double pilotFraction = 0.05;  // of N, split equally among the techniques
+  double pilotFraction = 0.05;  // of N, split equally among the techniques (pilotSamples)
   int stages = 1;               // after the pilot
   int poolRadius = 2;           // statistics pooled over (2r + 1)² pixels (alloc/Pooling.h)
   double minGain = 0.02;        // exact: the skip rule's least predicted gain (alloc/GridSearch.h, PooledSelection)
@@ -48,6 +48,18 @@ struct AdaptiveOptions {
   // (render/Render.cpp, docs/methods.md).
   MisWeights weights = MisWeights::Balance;
 };
+
+// The pilot's samples fill whole passes of this many lanes per technique where that
+// keeps the pilot within a quarter of the budget (pilotSamples): on a CPU a pass of
+// samplePixelStage costs the same however many of its lanes hold a sample
+// (kernels/sample.cl), and a 200-spp pilot's 5 per technique left 11 of 16 lanes idle.
+// 16, AVX-512's float width and twice AVX2's, on every device: every device then
+// renders the same image (docs/results.md, "The pilot in samplePixelStage").
+inline constexpr int kPilotLanes = 16;
+
+// The pilot's samples: f·N, at least two per technique, raised to whole passes of
+// kPilotLanes per technique where that is at most N/4.
+int pilotSamples(double pilotFraction, int spp, int techniqueCount);
 
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError
 // if the budget cannot hold a pilot of two samples per technique plus one stage.
