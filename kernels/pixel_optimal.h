@@ -313,9 +313,9 @@ MA_FN float columnShare(int s) { return (float)(s + 1) / (float)(MA_MAX_BANK_SHA
 
 // Eq. 6's mass under terms t, summed as pass 3 sums it (chunk by chunk, then over the
 // chunks): the same bits as the stage's own where C is the same. Its chunks' sums go to
-// the CDF's first rows, which pass 4 writes later. A sum over the cells in order would
-// be one chain of dependent additions: 3.5 % of a 200-spp render with `exact`, whose
-// pilot builds three of them per pixel.
+// the CDF's first rows, which pass 4 writes later. A sum over the cells in order is one
+// chain of dependent additions, which a lane's own build (samplePixelStage: vectorised
+// over the cells, not across pixels) cannot overlap.
 MA_FN float eq6MassByChunks(int count, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
   int chunks = count < MA_PIXEL_CHUNKS ? count : MA_PIXEL_CHUNKS;
   for (int j = 0; j < chunks; ++j) setRowFloat(rows, stride, MA_CDF_ROW(j), 0.0f);
