@@ -49,7 +49,8 @@ enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
 // count + 1 entries in its order (cdfPositionOfCell), as float bits; then each cell's
-// p_ρ mass and its f in the cells' order (the share columns read the p_ρ masses); then
+// p_ρ mass and its f in the cells' order (the share columns read the p_ρ masses; pass 4
+// leaves each cell's table mass in place of its f); then
 // per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms. (f in the CDF's rows, at its
 // cell's position, would save count rows, but pass 1's stores would no longer lie side
 // by side, and the compiler no longer vectorises it: 2.2× the time of the pilot stage.)
@@ -285,21 +286,30 @@ MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_
 
 MA_FN int cdfEntryRow(int count, int p, int product) { return cdfFirstRow(count, product) + p + 1; }
 
-// Three loops over the chunk's entries, each row holding in turn the cell's table
-// mass, the partial sum up to it and its entry: only the second carries a value from
-// cell to cell, and a compiler may vectorise the other two.
-MA_FN void pixelOptimalChunkCdf(MA_GLOBAL const float* cells, int count, int j, PixelOptimalTerms t, PixelTableScales s,
-                                int product, MA_LOCAL int* rows, int stride) {
+// Where pass 4 keeps each cell's table mass, in the cells' order: the envmap's CDF over
+// the cells' f, which its build no longer reads, and the product's over the envmap's
+// CDF, which is written after it.
+MA_FN int cellMassRow(int count, int c, int product) { return product ? MA_CDF_ROW(c) : MA_F_ROW(count, c); }
+
+// Pass 4a, over the cells in their order, side by side, so that a compiler may
+// vectorise it: each cell's table mass.
+MA_FN void pixelOptimalCellMasses(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, PixelTableScales s,
+                                  int product, MA_LOCAL int* rows, int stride) {
+  for (int c = 0; c < count; ++c)
+    setRowFloat(rows, stride, cellMassRow(count, c, product),
+                cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN)));
+}
+
+// Pass 4b, per chunk, two loops over its entries: the partial sums of its cells'
+// masses, which carry a value from cell to cell, then the entries, which a compiler
+// may vectorise.
+MA_FN void pixelOptimalChunkCdf(int count, int j, PixelOptimalTerms t, PixelTableScales s, int product,
+                                MA_LOCAL int* rows, int stride) {
   float offset = chunkCdfOffset(rows, stride, count, j, t, s, product);
   float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset), partial = 0.0f;
   int first = chunkStart(count, j), length = chunkLength(count, j), row = cdfEntryRow(count, first, product);
   for (int i = 0; i < length; ++i) {
-    int c = i * MA_PIXEL_CHUNKS + j;
-    setRowFloat(rows, stride, row + i,
-                cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN)));
-  }
-  for (int i = 0; i < length; ++i) {
-    partial += rowFloat(rows, stride, row + i);
+    partial += rowFloat(rows, stride, cellMassRow(count, i * MA_PIXEL_CHUNKS + j, product));
     setRowFloat(rows, stride, row + i, partial);
   }
   for (int i = 0; i < length; ++i)
@@ -382,9 +392,11 @@ MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongPa
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
   if (productCdf) {
     ProductCdfTerms p = productCdfTerms(rows, stride, count);
-    for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, p.t, p.s, 1, rows, stride);
+    pixelOptimalCellMasses(cells, count, p.t, p.s, 1, rows, stride);
+    for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(count, j, p.t, p.s, 1, rows, stride);
   }
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(cells, count, j, t, s, 0, rows, stride);
+  pixelOptimalCellMasses(cells, count, t, s, 0, rows, stride);
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(count, j, t, s, 0, rows, stride);
 }
 
 // The product technique's view of the pixel's cells: the envmap's, over the product's CDF.
