@@ -286,9 +286,9 @@ MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_
 
 MA_FN int cdfEntryRow(int count, int p, int product) { return cdfFirstRow(count, product) + p + 1; }
 
-// Where pass 4 keeps each cell's table mass, in the cells' order: the envmap's CDF over
-// the cells' f, which its build no longer reads, and the product's over the envmap's
-// CDF, which is written after it.
+// Where pass 4 keeps each cell's table mass, in the cells' order: the envmap table's
+// masses in the rows of the cells' f, which nothing reads after them; the product's,
+// built first, in the rows of the envmap's CDF, which is written after them.
 MA_FN int cellMassRow(int count, int c, int product) { return product ? MA_CDF_ROW(c) : MA_F_ROW(count, c); }
 
 // Pass 4a, over the cells in their order, side by side, so that a compiler may
