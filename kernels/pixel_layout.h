@@ -87,9 +87,8 @@ MA_FN int pixelRowBlock(int rows) { return MA_ROW_BLOCK(rows); }
 
 // The order of the pixel's CDF over its cells: chunk by chunk, chunk j holding cells j,
 // j + K, j + 2K, ... (K = MA_PIXEL_CHUNKS). The build adds each chunk's masses and
-// writes each chunk's entries on its own (kernels/pixel_optimal.h), so that a pass can
-// give each lane of a work-group its own chunks: cells side by side then lie in chunks
-// side by side, and the lanes read them side by side in local memory.
+// writes each chunk's entries on its own (kernels/pixel_optimal.h): the K sums of cells
+// side by side lie side by side, and a compiler vectorises across them.
 MA_FN int chunkOfCell(int c) { return c % MA_PIXEL_CHUNKS; }
 MA_FN int chunkLength(int count, int j) { return count / MA_PIXEL_CHUNKS + (j < count % MA_PIXEL_CHUNKS ? 1 : 0); }
 // The CDF position of chunk j's first cell.

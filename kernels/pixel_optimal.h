@@ -40,8 +40,8 @@
 
 // A cell's floats: its centre's direction x, y, z, its share of the plain pdf's mass,
 // its solid angle, and its spread as a lobe's exponent (cellLobe). Each float of every
-// cell in turn (field f of cell c at cells[f · count + c]), so that lanes that take
-// cells side by side read each float side by side.
+// cell in turn (field f of cell c at cells[f · count + c]), so that a pass over cells
+// side by side reads each float side by side.
 enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
 #define MA_CELL_FLOATS 6
 // The plain pdf's share of the pixel's table: the defensive part.

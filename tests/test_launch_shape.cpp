@@ -165,8 +165,7 @@ TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the b
     options.weights = optimal ? MisWeights::Optimal : MisWeights::Balance;
     SamplerConfig config = samplerConfigFor(methods[method], Estimator::MultiSample, 64, options);
     const int statSlots = HostSampler(scene, config).statSlots();
-    const int pixelRows = kern::pixelRowCount(optimal, scene.techniqueCount(), scene.productTables.tables > 0,
-                                              scene.tables.pixelCells, scene.productTables.pixelCells);
+    const int pixelRows = samplePixelRows(scene, config);
     CAPTURE(split, product, methodName(methods[method]), optimal, pixelPdf, localSize);
     cl::Kernel kernel(buildProgram(device, "sample.cl", sampleKernelOptions(scene, config, localSize)), "sampleStage");
     CHECK(kernel.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(device.device) ==

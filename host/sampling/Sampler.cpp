@@ -75,9 +75,13 @@ int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int device
   return scene.tables.useCdf || config.risCandidates > 0 ? 0 : deviceLanes;
 }
 
+int samplePixelRows(const Scene& scene, const SamplerConfig& config) {
+  return kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
+                             scene.tables.pixelCells, scene.productTables.pixelCells);
+}
+
 int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes) {
-  const int rows = kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
-                                       scene.tables.pixelCells, scene.productTables.pixelCells);
+  const int rows = samplePixelRows(scene, config);
   int pixels = lanes;
   while (pixels > 0 && pixelStageLocalBytes(lanes, pixels, rows) > localMemBytes) pixels /= 2;
   return pixels;
@@ -114,12 +118,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const DeviceLimits limits = deviceLimits(device.device);
   const LaunchShape shape = chooseLocalSize(
       limits,
-      [&](int size) {
-        return sampleKernelLocalBytes(
-            size, statSlots(), doubleSums_,
-            kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
-                                scene.tables.pixelCells, scene.productTables.pixelCells));
-      },
+      [&](int size) { return sampleKernelLocalBytes(size, statSlots(), doubleSums_, samplePixelRows(scene, config)); },
       localSize);
   localSize_ = shape.localSize;
   pixelLanes_ = samplePixelLanes(scene, config, limits.pixelLanes);

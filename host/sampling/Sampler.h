@@ -23,6 +23,9 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 // work-group.
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes);
 
+// A pixel's rows of local memory in both sampling kernels (kernels/pixel_layout.h).
+int samplePixelRows(const Scene& scene, const SamplerConfig& config);
+
 // The pixels a work-group of samplePixelStage at `lanes` lanes takes: `lanes`, or the
 // largest smaller power of two whose rows fit `localMemBytes` (pixelStageLocalBytes):
 // a per-pixel table of many cells. 0 where not even one pixel's fit.
