@@ -19,6 +19,7 @@
 #include "RawExr.h"
 #include "TestDevice.h"
 #include "cl/Device.h"
+#include "distributions/CompensatedPdf.h"
 #include "scene/ExrIO.h"
 
 namespace fs = std::filesystem;
@@ -166,6 +167,9 @@ TEST_CASE("render --scene spheres writes the background transparent black, and r
   CHECK(j["scene"]["covered_pixels"] == covered);
   CHECK(j["scene"]["view_deg"][0] == 75.0);
   CHECK(j["scene"]["envmap_pdf"]["used"] == "optimal-pixel");
+  // The pilot's cells, coarser than the render's, as it asked.
+  CHECK(j["scene"]["envmap_pdf"]["pilot_cells"]["across"] == misalloc::kDefaultPilotCellsAcross);
+  CHECK(j["scene"]["envmap_pdf"]["pixel_cells"]["across"] == misalloc::kDefaultPixelCellsAcross);
 }
 
 TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
@@ -203,6 +207,7 @@ TEST_CASE("bad options fail clearly and write nothing", "[cli][bad-input]") {
       {"--scene spheres:0x2", "--scene spheres:0x2"},
       {"--scene sphere --view 200", "--view 200"},
       {"--scene sphere --envmap-pdf optimal", "--envmap-pdf optimal with per-pixel normals or views: not implemented"},
+      {"--scene sphere --envmap-pdf optimal-pixel:16/32", "P, the pilot's cells across the map"},
       {"--scene sphere --product --envmap-pdf plain",
        "--product with --envmap-pdf plain and per-pixel normals or views: not implemented"},
       {"--product --method envmap", "--product with --method envmap: envmap samples the envmap alone"},

@@ -69,7 +69,7 @@ const std::vector<std::pair<Method, Estimator>> kMethodsWithBrdfSampling = {
 
 }  // namespace
 
-TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C, optimal and optimal-pixel:N",
+TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C, optimal, optimal-pixel:N and :N/P",
           "[compensated]") {
   CHECK_FALSE(parseEnvmapPdf("plain").compensated());
   CHECK(parseEnvmapPdf("plain").plain());
@@ -89,13 +89,26 @@ TEST_CASE("the option --envmap-pdf parses plain, compensated, compensated:C, opt
   CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:64")) == "optimal-pixel:64");
   CHECK(envmapPdfName(parseEnvmapPdf(fmt::format("optimal-pixel:{}", misalloc::kDefaultPixelCellsAcross))) ==
         "optimal-pixel");
+  // The pilot's cells: at most the default's, never more than the render's.
+  CHECK(parseEnvmapPdf("optimal-pixel").pilotCellsAcross == misalloc::kDefaultPilotCellsAcross);
+  CHECK(parseEnvmapPdf("optimal-pixel:64").pilotCellsAcross == misalloc::kDefaultPilotCellsAcross);
+  CHECK(parseEnvmapPdf("optimal-pixel:8").pilotCellsAcross == 8);
+  CHECK(parseEnvmapPdf("optimal-pixel:32/8").cellsAcross == 32);
+  CHECK(parseEnvmapPdf("optimal-pixel:32/8").pilotCellsAcross == 8);
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:32/8")) == "optimal-pixel:32/8");
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:32/32")) == "optimal-pixel:32/32");
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:32/16")) == "optimal-pixel");
+  CHECK(envmapPdfName(parseEnvmapPdf("optimal-pixel:8/8")) == "optimal-pixel:8");
   for (const char* bad : {"compensated:0", "compensated:1.5", "compensated:-1", "compensated:x", "compensated:",
                           "optimal:0.5", "Plain", "optimal-pixel:", "optimal-pixel:2", "optimal-pixel:12",
                           "optimal-pixel:128", "optimal-pixel:16x8", "optimal-pixel:-16", "optimal-pixel:0"})
     CHECK_THROWS_AS(parseEnvmapPdf(bad), InputError);
+  for (const char* bad : {"optimal-pixel:16/32", "optimal-pixel:32/", "optimal-pixel:32/2", "optimal-pixel:32/12",
+                          "optimal-pixel:/16", "optimal-pixel:32/16/8", "optimal-pixel:32/16x"})
+    CHECK_THROWS_AS(parseEnvmapPdf(bad), InputError);
 }
 
-TEST_CASE("compare names the optimal pdf per pixel's cells where they are not the default's",
+TEST_CASE("compare names the optimal pdf per pixel's cells and the pilot's where they are not the default's",
           "[compensated][compare]") {
   // Each case's runs go to a folder of its label: two cell counts must not share one.
   SceneOptions o;
@@ -105,6 +118,8 @@ TEST_CASE("compare names the optimal pdf per pixel's cells where they are not th
   CHECK(misalloc::caseLabel(o) == "forest_slope-spheres-optimal-pixel");
   o.envmapPdf = parseEnvmapPdf("optimal-pixel:16");
   CHECK(misalloc::caseLabel(o) == "forest_slope-spheres-optimal-pixel-16");
+  o.envmapPdf = parseEnvmapPdf("optimal-pixel:32/8");
+  CHECK(misalloc::caseLabel(o) == "forest_slope-spheres-optimal-pixel-32-8");
 }
 
 TEST_CASE("L̄ of a cos^K map is 1/(2(K+1)) and the compensated pdf drops every texel at or below it", "[compensated]") {

@@ -182,6 +182,51 @@ TEST_CASE("pixels that take no samples in a stage are left out of its launch and
     }
 }
 
+// The optimal pdf per pixel's pilot table (Scene::pilotTables): a stage that keeps
+// statistics samples from the coarser cells, the last stage from the scene's own. With
+// 32 cells across and the pilot's 16, a stage with stored samples (samplePixelStage on a
+// CPU) or running sums (sampleStage) is bit for bit that of a scene of 16 cells across,
+// and a stage without statistics that of a scene whose pilot has 32, on the device and
+// on the reference alike.
+TEST_CASE("a stage that keeps statistics samples from the pilot's cells, the last stage from the scene's",
+          "[sampler][optimal]") {
+  const auto scene = [](const std::string& pdf) {
+    Scene s = smallScene("venice_sunset", "seed000", 24, 16, false, EnvmapSampler::Alias, 0, pdf);
+    giveRandomFrames(s, 3);
+    return s;
+  };
+  const Scene coarsePilot = scene("optimal-pixel:32/16"), samePilot = scene("optimal-pixel:32/32"),
+              coarse = scene("optimal-pixel:16");
+  REQUIRE(coarsePilot.pilotTables.pixelCells == coarse.tables.pixelCells);
+  REQUIRE(coarsePilot.tables.pixelCells == 4 * coarse.tables.pixelCells);
+  CHECK(samePilot.pilotTables.pixelCells == 0);
+  CHECK(coarse.pilotTables.pixelCells == 0);
+  for (const SamplerConfig config :
+       {SamplerConfig{Estimator::MultiSample, 0, 40}, SamplerConfig{Estimator::MultiSample, MA_STATS_TECHNIQUE, 0}})
+    for (bool device : {false, true}) {
+      INFO(fmt::format("stored samples {}, device {}", config.sampleCapacity, device));
+      auto sampler = [&](const Scene& s) -> std::unique_ptr<StageSampler> {
+        if (device) return std::make_unique<Sampler>(testDevice(), s, config);
+        return std::make_unique<HostSampler>(s, config);
+      };
+      StagePlan plan = singleStagePlan(coarsePilot, Method::Equal, 40);
+      for (int p = 0; p < coarsePilot.pixelCount(); ++p) {
+        plan.counts[2 * p] = 4 + (p * 5) % 33;
+        plan.counts[2 * p + 1] = 40 - plan.counts[2 * p];
+      }
+      for (bool keepStatistics : {true, false}) {
+        plan.keepStatistics = keepStatistics;
+        const StageResult a = sampler(coarsePilot)->run(plan, 9);
+        const StageResult b = sampler(keepStatistics ? coarse : samePilot)->run(plan, 9);
+        const StageResult other = sampler(keepStatistics ? samePilot : coarse)->run(plan, 9);
+        INFO(fmt::format("keeps statistics {}", keepStatistics));
+        CHECK(a.rgb == b.rgb);
+        CHECK(a.moments == b.moments);
+        CHECK(a.rgb != other.rgb);  // the two cell sizes sample differently: the check can fail
+      }
+    }
+}
+
 // With share columns, a stored sample holds the envmap's pdf under each share's table,
 // the bank's or the optimal pdf per pixel's; the share its stage drew with must hold
 // exactly the pdf the sample was weighted with, and the rest of the record must be what a

@@ -73,9 +73,10 @@ void SceneArgs::addEnvmapPdf(CLI::App& command) {
   envmapPdfOption = command.add_option(
       "--envmap-pdf", envmapPdf,
       "plain (∝ luminance), compensated[:C] (∝ max(0, L - 2(1-C) mean L), [Kar19] eq. 14; C default 0.5) or "
-      "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables) or optimal-pixel[:N] ([Kar19] eq. "
-      "6 for each pixel's own normal, view, BRDF and share over N x N/2 cells of the map, N a power of two from 4 "
-      "to 64, default 32, built as it renders); default optimal, plain with "
+      "optimal ([Kar19] eq. 9 per BRDF bin and envmap share, a bank of tables) or optimal-pixel[:N[/P]] ([Kar19] "
+      "eq. 6 for each pixel's own normal, view, BRDF and share over N x N/2 cells of the map, N a power of two from "
+      "4 to 64, default 32, built as it renders; the stages that keep statistics, the pilot's, over P x P/2, P a "
+      "power of two from 4 to N, default min(N, 16)); default optimal, plain with "
       "--split-brdf or --method envmap, optimal-pixel on spheres, G-buffers and meshes");
 }
 

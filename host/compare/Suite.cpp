@@ -1,5 +1,6 @@
 #include "compare/Suite.h"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <string>
@@ -20,9 +21,13 @@ std::string caseLabel(const SceneOptions& scene) {
   if (scene.product) name += "-product";
   if (scene.envmapPdf.compensated()) name += "-comp" + envmapPdfName(scene.envmapPdf).substr(sizeof("compensated"));
   if (scene.envmapPdf.optimal()) name += "-optimal";
-  if (scene.envmapPdf.pixelOptimal()) name += "-optimal-pixel";
-  if (scene.envmapPdf.pixelOptimal() && scene.envmapPdf.cellsAcross != kDefaultPixelCellsAcross)
-    name += "-" + std::to_string(scene.envmapPdf.cellsAcross);
+  if (scene.envmapPdf.pixelOptimal()) {
+    // "optimal-pixel", "optimal-pixel:N" or "optimal-pixel:N/P" as "-optimal-pixel", "-N", "-N-P".
+    std::string spec = envmapPdfName(scene.envmapPdf);
+    std::replace(spec.begin(), spec.end(), ':', '-');
+    std::replace(spec.begin(), spec.end(), '/', '-');
+    name += "-" + spec;
+  }
   return name;
 }
 

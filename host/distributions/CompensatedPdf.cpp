@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <optional>
+#include <string_view>
 
 #include "Constants.h"
 #include "Error.h"
@@ -14,18 +15,24 @@ namespace misalloc {
 
 namespace {
 
-// The number after "name:" in spec, whole; nullopt if there is none or more follows it.
+// The number that is the whole of text; nullopt if there is none or more follows it.
 template <typename T>
-std::optional<T> parameterOf(const std::string& spec, const std::string& name) {
-  const char* first = spec.data() + name.size() + 1;
-  const char* last = spec.data() + spec.size();
+std::optional<T> wholeNumber(std::string_view text) {
   T value{};
-  auto [stop, error] = std::from_chars(first, last, value);
-  if (error == std::errc() && stop == last) return value;
+  auto [stop, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error == std::errc() && stop == text.data() + text.size()) return value;
   return std::nullopt;
 }
 
+// The number after "name:" in spec, whole.
+template <typename T>
+std::optional<T> parameterOf(std::string_view spec, const std::string& name) {
+  return wholeNumber<T>(spec.substr(name.size() + 1));
+}
+
 bool hasParameter(const std::string& spec, const std::string& name) { return spec.rfind(name + ":", 0) == 0; }
+
+bool cellsAcrossAllowed(int n, int most) { return n >= kMinPixelCellsAcross && n <= most && (n & (n - 1)) == 0; }
 
 }  // namespace
 
@@ -42,14 +49,25 @@ EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option) {
         fmt::format("{} {}: C, the envmap technique's share of the samples, must lie in (0, 1]", option, spec));
   }
   if (hasParameter(spec, pixelOptimal)) {
-    const std::optional<int> n = parameterOf<int>(spec, pixelOptimal);
-    if (n && *n >= kMinPixelCellsAcross && *n <= kMaxPixelCellsAcross && (*n & (*n - 1)) == 0)
-      return {EnvmapPdf::Kind::PixelOptimal, 0.5, *n};
-    throw InputError(fmt::format("{} {}: N, the cells across the map, must be a power of two from {} to {}", option,
-                                 spec, kMinPixelCellsAcross, kMaxPixelCellsAcross));
+    const std::size_t slash = spec.find('/');
+    const std::string cells = spec.substr(0, slash);
+    const std::optional<int> n = parameterOf<int>(cells, pixelOptimal);
+    if (!n || !cellsAcrossAllowed(*n, kMaxPixelCellsAcross))
+      throw InputError(fmt::format("{} {}: N, the cells across the map, must be a power of two from {} to {}", option,
+                                   spec, kMinPixelCellsAcross, kMaxPixelCellsAcross));
+    EnvmapPdf pdf{EnvmapPdf::Kind::PixelOptimal, 0.5, *n, std::min(*n, kDefaultPilotCellsAcross)};
+    if (slash == std::string::npos) return pdf;
+    const std::optional<int> pilot = wholeNumber<int>(std::string_view(spec).substr(slash + 1));
+    if (!pilot || !cellsAcrossAllowed(*pilot, *n))
+      throw InputError(fmt::format("{} {}: P, the pilot's cells across the map, must be a power of two from {} to N",
+                                   option, spec, kMinPixelCellsAcross));
+    pdf.pilotCellsAcross = *pilot;
+    return pdf;
   }
-  throw InputError(fmt::format(
-      "{} '{}': expected plain, compensated, compensated:C, optimal, optimal-pixel or optimal-pixel:N", option, spec));
+  throw InputError(
+      fmt::format("{} '{}': expected plain, compensated, compensated:C, optimal, optimal-pixel, optimal-pixel:N or "
+                  "optimal-pixel:N/P",
+                  option, spec));
 }
 
 std::string envmapPdfName(const EnvmapPdf& pdf) {
@@ -58,9 +76,12 @@ std::string envmapPdfName(const EnvmapPdf& pdf) {
       return fmt::format("compensated:{:g}", pdf.envmapFraction);
     case EnvmapPdf::Kind::Optimal:
       return "optimal";
-    case EnvmapPdf::Kind::PixelOptimal:
+    case EnvmapPdf::Kind::PixelOptimal: {
+      const bool defaultPilot = pdf.pilotCellsAcross == std::min(pdf.cellsAcross, kDefaultPilotCellsAcross);
+      if (!defaultPilot) return fmt::format("optimal-pixel:{}/{}", pdf.cellsAcross, pdf.pilotCellsAcross);
       return pdf.cellsAcross == kDefaultPixelCellsAcross ? "optimal-pixel"
                                                          : fmt::format("optimal-pixel:{}", pdf.cellsAcross);
+    }
     case EnvmapPdf::Kind::Plain:
       break;
   }

@@ -16,6 +16,11 @@ namespace misalloc {
 // the optimal pdf per pixel"); and the range a spec may ask for.
 constexpr int kDefaultPixelCellsAcross = 32;
 constexpr int kMinPixelCellsAcross = 4, kMaxPixelCellsAcross = 64;
+// The pilot's cells across at most (EnvmapPdf::pilotCellsAcross): a stage that keeps
+// statistics builds a table of 16 × 8 cells, a quarter of the default's build, since
+// its samples weigh little in the image and its share columns only rank α_0
+// (docs/results.md, "A coarser table for the pilot").
+constexpr int kDefaultPilotCellsAcross = 16;
 
 // The shape of the envmap technique's pdf (`--envmap-pdf`).
 // `Optimal` is [Kar19] eq. 9 for each pixel's own BRDF and envmap share (a bank of
@@ -27,8 +32,10 @@ struct EnvmapPdf {
   // C of [Kar19] eq. 14: the envmap technique's share of the samples, in (0, 1].
   double envmapFraction = 0.5;
   // PixelOptimal: its cells across the map (half as many down), a power of two
-  // (distributions/EnvmapDistribution.h, pixelCellLog2).
+  // (distributions/EnvmapDistribution.h, pixelCellLog2); and those of the table built
+  // by the stages that keep statistics (the pilot's), at most cellsAcross.
   int cellsAcross = kDefaultPixelCellsAcross;
+  int pilotCellsAcross = kDefaultPilotCellsAcross;
 
   bool plain() const { return kind == Kind::Plain; }
   bool compensated() const { return kind == Kind::Compensated; }
@@ -36,13 +43,15 @@ struct EnvmapPdf {
   bool pixelOptimal() const { return kind == Kind::PixelOptimal; }
 };
 
-// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, "optimal", "optimal-pixel" or
+// "plain", "compensated", "compensated:C" with 0 < C ≤ 1, "optimal", "optimal-pixel",
 // "optimal-pixel:N" with N cells across, a power of two in [kMinPixelCellsAcross,
-// kMaxPixelCellsAcross]; throws InputError, naming `option`, otherwise.
+// kMaxPixelCellsAcross], and the pilot's min(N, kDefaultPilotCellsAcross), or
+// "optimal-pixel:N/P" with the pilot's P, a power of two from kMinPixelCellsAcross to N;
+// throws InputError, naming `option`, otherwise.
 EnvmapPdf parseEnvmapPdf(const std::string& spec, const std::string& option = "--envmap-pdf");
 
-// "plain", "compensated:C", "optimal", "optimal-pixel" (the default cells) or
-// "optimal-pixel:N", which parseEnvmapPdf reads back.
+// "plain", "compensated:C", "optimal", "optimal-pixel" (the default cells),
+// "optimal-pixel:N" or "optimal-pixel:N/P", which parseEnvmapPdf reads back.
 std::string envmapPdfName(const EnvmapPdf& pdf);
 
 // L̄ of [Kar19] eq. 14: the luminance of a W×H lat-long map (row-major, row 0 at the

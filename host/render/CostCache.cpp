@@ -159,6 +159,7 @@ std::string costCacheKey(const StageSampler& sampler, const Scene& image) {
   addConfig(h, sampler.config());
   for (const std::string& name : sampler.scene().techniqueNames()) h.add(name);
   addTables(h, sampler.scene().tables);
+  addTables(h, sampler.scene().pilotTables);
   const ProductTables& product = sampler.scene().productTables;
   h.addValue(product.tables);
   h.addValue(product.pixelCells);

@@ -25,6 +25,14 @@ std::string estimatorName(Estimator estimator) {
 
 namespace {
 
+nlohmann::json pixelCellsJson(const EnvmapTables& tables) {
+  return {{"cells", tables.pixelCells},
+          {"across", (tables.width + (1 << tables.blockLog2) - 1) >> tables.blockLog2},
+          {"cell_texels", 1 << (2 * tables.blockLog2)},
+          {"table_bytes", (tables.aliasTable.size() + tables.blockProbs.size()) * 4},
+          {"build_seconds", tables.bankBuildSeconds}};
+}
+
 // [Kar19]: the pdf asked for and the one sampled with; a compensated pdf that left no
 // texel positive fell back to plain.
 nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
@@ -41,12 +49,7 @@ nlohmann::json envmapPdfJson(const EnvmapTables& tables) {
     pdf["fallback_to_plain"] = !tables.followsEnvmapShare();
     if (!tables.followsEnvmapShare()) pdf["fallback_reason"] = "the map is black";
   }
-  if (tables.pixelCells > 0)
-    pdf["pixel_cells"] = {{"cells", tables.pixelCells},
-                          {"across", (tables.width + (1 << tables.blockLog2) - 1) >> tables.blockLog2},
-                          {"cell_texels", 1 << (2 * tables.blockLog2)},
-                          {"table_bytes", (tables.aliasTable.size() + tables.blockProbs.size()) * 4},
-                          {"build_seconds", tables.bankBuildSeconds}};
+  if (tables.pixelCells > 0) pdf["pixel_cells"] = pixelCellsJson(tables);
   if (tables.hasBank()) {
     const BankVariances& v = tables.bankVariances;
     const std::size_t entries = std::size_t(tables.brdfBins) * tables.bankShares;
@@ -117,6 +120,7 @@ nlohmann::json sceneJson(const Scene& scene) {
                          {"techniques", scene.techniqueNames()},
                          {"envmap_sampler", scene.tables.useCdf ? "cdf" : "alias"},
                          {"envmap_pdf", envmapPdfJson(scene.tables)}};
+  if (scene.pilotTables.pixelCells > 0) json["envmap_pdf"]["pilot_cells"] = pixelCellsJson(scene.pilotTables);
   if (scene.productTables.pixelCells)
     json["product"] = {{"from", "pixel_cells"}, {"plain_share", MA_PIXEL_PLAIN_SHARE}, {"table_bytes", 0}};
   else if (scene.productTables.enabled())

@@ -100,13 +100,14 @@ void HostSampler::forgetStages() {
 
 StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
   const int M = scene_.techniqueCount();
-  kern::EnvmapView env = makeEnvmapView(scene_.tables, scene_.envmap.coskExponent);
+  const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
+  const EnvmapTables& tables = stageTables(scene_, keepsStatistics(config));
+  kern::EnvmapView env = makeEnvmapView(tables, scene_.envmap.coskExponent);
   kern::TechniqueSet ts;
   ts.techniqueCount = M;
   ts.splitBrdf = scene_.options.splitBrdf ? 1 : 0;
   ts.product = makeProductView(scene_.productTables);
   ts.productMixture = {};
-  const SamplerConfig config = plan.keepStatistics ? config_ : plainConfig(config_);
   const SampleColumns columns = sampleColumns(scene_, config);
   ts.sharePdfs = columns.shareColumns > 0 ? 1 : 0;
   const int slots = plan.keepStatistics ? statSlots() : 0;
@@ -129,9 +130,9 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
-      kern::buildPixelOptimalCdf(scene_.tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z,
-                                 sp.mirrorFrame.z, kern::stageEnvmapShare(kern::productEnabled(ts.product), c),
-                                 ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(), 1);
+      kern::buildPixelOptimalCdf(tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z,
+                                 kern::stageEnvmapShare(kern::productEnabled(ts.product), c), ts.sharePdfs,
+                                 ts.product.pixelCells, pixelCdf.data(), 1);
       pixelEnv.pixelCdf = pixelCdf.data();
     }
     kern::PixelSums sums = kern::zeroPixelSums();

@@ -42,6 +42,11 @@ std::vector<float> withSpareRecord(std::vector<float> samples, const Scene& scen
   return samples;
 }
 
+// The rows of the larger of the two sampling kernels, which share a launch shape.
+int largestPixelRows(const Scene& scene, const SamplerConfig& config) {
+  return std::max(samplePixelRows(scene, config), samplePixelRows(scene, plainConfig(config)));
+}
+
 // A frame's axis as kernels/sample.cl reads it (frameOfRows): x, y, z.
 void writeVec3(const kern::MaVec3& v, float* w) {
   w[0] = v.x;
@@ -53,7 +58,7 @@ void writeVec3(const kern::MaVec3& v, float* w) {
 
 std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config, int localSize, int pixelLanes,
                                 int groupPixels) {
-  const EnvmapTables& t = scene.tables;
+  const EnvmapTables& t = stageTables(scene, keepsStatistics(config));
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
       "-DMA_CDF_STEPS_COL={} -DMA_ANALYTIC_RADIANCE={} -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
@@ -77,11 +82,11 @@ int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int device
 
 int samplePixelRows(const Scene& scene, const SamplerConfig& config) {
   return kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
-                             scene.tables.pixelCells, scene.productTables.pixelCells);
+                             stageTables(scene, keepsStatistics(config)).pixelCells, scene.productTables.pixelCells);
 }
 
 int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes) {
-  const int rows = samplePixelRows(scene, config);
+  const int rows = largestPixelRows(scene, config);
   int pixels = lanes;
   while (pixels > 0 && pixelStageLocalBytes(lanes, pixels, rows) > localMemBytes) pixels /= 2;
   return pixels;
@@ -89,10 +94,12 @@ int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int l
 
 SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
   const EnvmapTables& t = scene.tables;
-  texels = upload(device, t.texels);
-  cdfTable = upload(device, t.cdfTable);
-  aliasTable = upload(device, t.aliasTable);
-  blockProbs = upload(device, t.blockProbs);
+  auto uploadTables = [&](const EnvmapTables& tables) {
+    return Envmap{upload(device, tables.texels), upload(device, tables.cdfTable), upload(device, tables.aliasTable),
+                  upload(device, tables.blockProbs)};
+  };
+  envmap_ = uploadTables(t);
+  pilotEnvmap_ = &stageTables(scene, true) == &t ? envmap_ : uploadTables(stageTables(scene, true));
   productFloats = upload(device, scene.productTables.floats);
   productWords = upload(device, scene.productTables.words);
   // The kernel's shading point rows (kernels/pixel_layout.h), from the reference's.
@@ -118,7 +125,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const DeviceLimits limits = deviceLimits(device.device);
   const LaunchShape shape = chooseLocalSize(
       limits,
-      [&](int size) { return sampleKernelLocalBytes(size, statSlots(), doubleSums_, samplePixelRows(scene, config)); },
+      [&](int size) { return sampleKernelLocalBytes(size, statSlots(), doubleSums_, largestPixelRows(scene, config)); },
       localSize);
   localSize_ = shape.localSize;
   pixelLanes_ = samplePixelLanes(scene, config, limits.pixelLanes);
@@ -202,6 +209,7 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   const bool statistics = plan.keepStatistics && keepsStatistics(config_);
   cl::Kernel& kernel = statistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
+  const SceneBuffers::Envmap& env = b.envmap(statistics);
   if (config_.optimalWeights) writeCoefficients(plan, range);
   // The optimal weights' coefficients are an argument of their kernels only.
   auto bind = [&](const auto&... args) {
@@ -210,11 +218,11 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
     else
       bindKernelArgs(kernel, args...);
   };
-  bind(b.texels, b.cdfTable, b.aliasTable, b.blockProbs, b.productFloats, b.productWords, cl_int(scene_.tables.width),
-       cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints, counts_, firstIndex_,
-       cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
-       cl_int(order.size()), pixelOrder_, rgb_, moments_, stats_, samples_, cl_int(firstSlot),
-       cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
+  bind(env.texels, env.cdfTable, env.aliasTable, env.blockProbs, b.productFloats, b.productWords,
+       cl_int(scene_.tables.width), cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints,
+       counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
+       cl_int(scene_.firstPixel), cl_int(order.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
+       cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
   const size_t groups = lanes > 0 ? (order.size() + size_t(groupPixels_) - 1) / size_t(groupPixels_) : 0;

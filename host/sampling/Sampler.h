@@ -23,12 +23,15 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
 // work-group.
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes);
 
-// A pixel's rows of local memory in both sampling kernels (kernels/pixel_layout.h).
+// A pixel's rows of local memory in the sampling kernels built for `config`
+// (kernels/pixel_layout.h): with the pilot's cells where it keeps statistics
+// (stageTables).
 int samplePixelRows(const Scene& scene, const SamplerConfig& config);
 
 // The pixels a work-group of samplePixelStage at `lanes` lanes takes: `lanes`, or the
-// largest smaller power of two whose rows fit `localMemBytes` (pixelStageLocalBytes):
-// a per-pixel table of many cells. 0 where not even one pixel's fit.
+// largest smaller power of two whose rows fit `localMemBytes` (pixelStageLocalBytes) in
+// the kernels with and without the config's statistics: a per-pixel table of many
+// cells. 0 where not even one pixel's fit.
 int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes);
 
 // A scene's read-only device buffers: the envmap's tables and the BRDF grid. Devices
@@ -39,10 +42,19 @@ class SceneBuffers {
   SceneBuffers(const Device& device, const Scene& scene);
   cl_context context() const { return context_; }
 
-  cl::Buffer texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, shadingPoints;
+  // An EnvmapTables' buffers (kernels/envmap.h, EnvmapView).
+  struct Envmap {
+    cl::Buffer texels, cdfTable, aliasTable, blockProbs;
+  };
+  // The tables of a stage (stageTables): the pilot's are the same buffers where the
+  // scene has none of its own.
+  const Envmap& envmap(bool keepsStatistics) const { return keepsStatistics ? pilotEnvmap_ : envmap_; }
+
+  cl::Buffer productFloats, productWords, shadingPoints;
 
  private:
   cl_context context_;
+  Envmap envmap_, pilotEnvmap_;
 };
 
 // Runs kernels/sample.cl on a device: sampleStage, across pixels; on a CPU, stages

@@ -31,14 +31,17 @@ DeviceError explain(const cl::Error& e, const Device& device, const Scene& scene
   return explainBufferError(e, device, bufferOption(scene, config), scene.pixelCount());
 }
 
-// The envmap's sampling tables must fit the device, each in one buffer: refused
-// before they are uploaded, with the figures.
+// The envmap's sampling tables (and the pilot's, Scene::pilotTables) must fit the
+// device, each in one buffer: refused before they are uploaded, with the figures.
 void requireTablesFit(const Device& device, const Scene& scene) {
   const EnvmapTables& t = scene.tables;
-  const uint64_t sizes[] = {t.texels.size() * sizeof(float), t.cdfTable.size() * sizeof(float),
-                            t.aliasTable.size() * sizeof(uint32_t), t.blockProbs.size() * sizeof(float)};
-  const uint64_t largest = *std::max_element(std::begin(sizes), std::end(sizes));
-  const uint64_t total = sizes[0] + sizes[1] + sizes[2] + sizes[3];
+  uint64_t largest = 0, total = 0;
+  for (const EnvmapTables* tables : {&t, &scene.pilotTables}) {
+    const uint64_t sizes[] = {tables->texels.size() * sizeof(float), tables->cdfTable.size() * sizeof(float),
+                              tables->aliasTable.size() * sizeof(uint32_t), tables->blockProbs.size() * sizeof(float)};
+    largest = std::max(largest, *std::max_element(std::begin(sizes), std::end(sizes)));
+    total += sizes[0] + sizes[1] + sizes[2] + sizes[3];
+  }
   const uint64_t maxAlloc = device.device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
   const uint64_t global = device.device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
   if (largest > maxAlloc || total > global)

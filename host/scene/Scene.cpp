@@ -179,7 +179,14 @@ Scene makeScene(const SceneOptions& options) {
           "technique (M = 2)");
     // Its own sampler whatever --envmap-sampler says: a cell by the pixel's CDF, a texel
     // in it by the cell's alias table.
-    scene.tables = buildPixelOptimalEnvmapTables(scene.envmap, options.envmapPdf.cellsAcross);
+    const EnvmapPdf& pdf = options.envmapPdf;
+    scene.tables = buildPixelOptimalEnvmapTables(scene.envmap, pdf.cellsAcross);
+    // The tables know their own cells; the pilot's, which the report names, are the scene's.
+    scene.tables.requestedPdf.pilotCellsAcross = pdf.pilotCellsAcross;
+    if (scene.tables.pdf.pixelOptimal()) scene.tables.pdf.pilotCellsAcross = pdf.pilotCellsAcross;
+    const int pilotLog2 = pixelCellLog2(scene.envmap.image.width, scene.envmap.image.height, pdf.pilotCellsAcross);
+    if (scene.tables.pixelCells > 0 && pilotLog2 != scene.tables.blockLog2)
+      scene.pilotTables = buildPixelOptimalEnvmapTables(scene.envmap, pdf.pilotCellsAcross);
   } else {
     scene.tables = buildEnvmapTables(scene.envmap, options.sampler, options.envmapPdf);
   }
@@ -217,7 +224,12 @@ Scene withPlainEnvmapPdf(const Scene& scene) {
   Scene plain = scene;
   plain.options.envmapPdf = {};
   plain.tables = buildEnvmapTables(plain.envmap, plain.options.sampler);
+  plain.pilotTables = {};
   return plain;
+}
+
+const EnvmapTables& stageTables(const Scene& scene, bool keepsStatistics) {
+  return keepsStatistics && scene.pilotTables.pixelCells > 0 ? scene.pilotTables : scene.tables;
 }
 
 }  // namespace misalloc

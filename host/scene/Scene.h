@@ -59,6 +59,9 @@ struct Scene {
   std::string envmapPath;  // the resolved file, empty for procedural maps
   Envmap envmap;           // its image keeps width and height; the texels live in `tables`
   EnvmapTables tables;
+  // The optimal pdf per pixel's coarser cells, for the stages that keep statistics
+  // (EnvmapPdf::pilotCellsAcross); none (pixelCells 0) where they would be the same.
+  EnvmapTables pilotTables;
   ProductTables productTables;  // --product; none otherwise
   BrdfGrid grid;
   SceneGeometry geometry;  // each pixel's normal and mirror direction
@@ -80,6 +83,10 @@ struct Scene {
 // The one mirror direction of a flat scene, for which the optimal pdf's bank and the
 // product tables are built; throws InputError naming `option` for any other geometry.
 const Vec3f& flatMirror(const SceneGeometry& geometry, const std::string& option);
+
+// The tables a stage samples from: the pilot's where it keeps statistics and the scene
+// has them, else the scene's own. The product's cells are the same (kernels/product.h).
+const EnvmapTables& stageTables(const Scene& scene, bool keepsStatistics);
 
 // Counts [pixel·M + k] with the background's set to 0 (SceneGeometry::covered): it takes
 // no samples, whatever a method, an allocation or a calibration would give it.
