@@ -201,6 +201,10 @@ TEST_CASE("a stage that keeps statistics samples from the pilot's cells, the las
   REQUIRE(coarsePilot.tables.pixelCells == 4 * coarse.tables.pixelCells);
   CHECK(samePilot.pilotTables.pixelCells == 0);
   CHECK(coarse.pilotTables.pixelCells == 0);
+  // A device's copy leaves them out for samplers that keep no statistics.
+  CHECK_THROWS_AS(SceneBuffers(testDevice(), coarsePilot, false).envmap(true), std::logic_error);
+  CHECK(SceneBuffers(testDevice(), coarsePilot, true).envmap(true).texels() != nullptr);
+  CHECK(SceneBuffers(testDevice(), samePilot, false).envmap(true).texels() != nullptr);
   for (const SamplerConfig config :
        {SamplerConfig{Estimator::MultiSample, 0, 40}, SamplerConfig{Estimator::MultiSample, MA_STATS_TECHNIQUE, 0}})
     for (bool device : {false, true}) {

@@ -92,14 +92,18 @@ int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int l
   return pixels;
 }
 
-SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(device.context()) {
+SceneBuffers::SceneBuffers(const Device& device, const Scene& scene, bool withPilot) : context_(device.context()) {
   const EnvmapTables& t = scene.tables;
   auto uploadTables = [&](const EnvmapTables& tables) {
     return Envmap{upload(device, tables.texels), upload(device, tables.cdfTable), upload(device, tables.aliasTable),
                   upload(device, tables.blockProbs)};
   };
   envmap_ = uploadTables(t);
-  pilotEnvmap_ = &stageTables(scene, true) == &t ? envmap_ : uploadTables(stageTables(scene, true));
+  const EnvmapTables& pilot = stageTables(scene, true);
+  if (&pilot == &t)
+    pilotEnvmap_ = envmap_;
+  else if (withPilot)
+    pilotEnvmap_ = uploadTables(pilot);
   productFloats = upload(device, scene.productTables.floats);
   productWords = upload(device, scene.productTables.words);
   // The kernel's shading point rows (kernels/pixel_layout.h), from the reference's.
@@ -115,6 +119,12 @@ SceneBuffers::SceneBuffers(const Device& device, const Scene& scene) : context_(
     writeVec3(sp.mirrorFrame.z, w + kern::ROW_MIRROR_X);
   }
   shadingPoints = upload(device, words);
+}
+
+const SceneBuffers::Envmap& SceneBuffers::envmap(bool keepsStatistics) const {
+  if (!keepsStatistics) return envmap_;
+  if (pilotEnvmap_.texels() == nullptr) throw std::logic_error("scene buffers made without the pilot's tables");
+  return pilotEnvmap_;
 }
 
 Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& config, int localSize,
@@ -150,7 +160,7 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
                                 device.device.getInfo<CL_DRIVER_VERSION>(),
                                 device.device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>(), embeddedSourcesHash(),
                                 plainOptions, keepsStatistics(config) ? statisticsOptions : "no statistics kernel");
-  if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene);
+  if (!sceneBuffers) sceneBuffers = std::make_shared<SceneBuffers>(device, scene, keepsStatistics(config));
   if (sceneBuffers->context() != device.context()) throw std::logic_error("scene buffers of another context");
   sceneBuffers_ = std::move(sceneBuffers);
   // OpenCL buffers cannot be empty: a method without running sums or stored samples

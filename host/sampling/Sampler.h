@@ -39,7 +39,9 @@ int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int l
 // that their caches hold one set of tables.
 class SceneBuffers {
  public:
-  SceneBuffers(const Device& device, const Scene& scene);
+  // `withPilot`: the pilot's tables too (Scene::pilotTables), for samplers that keep
+  // statistics; others leave them out, as large as the scene's own.
+  SceneBuffers(const Device& device, const Scene& scene, bool withPilot);
   cl_context context() const { return context_; }
 
   // An EnvmapTables' buffers (kernels/envmap.h, EnvmapView).
@@ -47,8 +49,8 @@ class SceneBuffers {
     cl::Buffer texels, cdfTable, aliasTable, blockProbs;
   };
   // The tables of a stage (stageTables): the pilot's are the same buffers where the
-  // scene has none of its own.
-  const Envmap& envmap(bool keepsStatistics) const { return keepsStatistics ? pilotEnvmap_ : envmap_; }
+  // scene has none of its own. Throws std::logic_error for the pilot's left out.
+  const Envmap& envmap(bool keepsStatistics) const;
 
   cl::Buffer productFloats, productWords, shadingPoints;
 
@@ -66,8 +68,8 @@ class Sampler : public StageSampler {
  public:
   // localSize 0: the device's own (cl/LaunchShape.h); > 0: --local-size, checked against it.
   // `device` and `scene` must outlive the sampler (ARCHITECTURE.md, Lifetimes).
-  // `sceneBuffers`: made for this device's context, shared with other samplers; null:
-  // its own.
+  // `sceneBuffers`: made for this device's context, shared with other samplers, with the
+  // pilot's tables where `config` keeps statistics; null: its own.
   Sampler(const Device& device, const Scene& scene, const SamplerConfig& config = {}, int localSize = 0,
           std::shared_ptr<const SceneBuffers> sceneBuffers = nullptr);
   StageResult runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) override;

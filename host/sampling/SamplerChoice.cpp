@@ -89,7 +89,7 @@ std::unique_ptr<StageSampler> makeDeviceSampler(const Device* device, const Scen
   requireTablesFit(*device, scene);
   try {
     std::shared_ptr<const SceneBuffers>& buffers = shared[device->context()];
-    if (!buffers) buffers = std::make_shared<SceneBuffers>(*device, scene);
+    if (!buffers) buffers = std::make_shared<SceneBuffers>(*device, scene, keepsStatistics(config));
     // The constructor allocates every other buffer and launches the kernel once.
     return std::make_unique<Sampler>(*device, scene, config, localSize, buffers);
   } catch (const cl::Error& e) {
