@@ -32,6 +32,13 @@ typedef ulong ma_ulong;
 #endif
 // Loops left in the sample loop make PoCL split it at implicit barriers: unroll them.
 #define MA_UNROLL _Pragma("unroll")
+// A loop over a pixel's cells within one work-item (samplePixelStage's lanes, a CPU's)
+// at the float16 width: LLVM prefers 256-bit vectors on AVX-512 CPUs (docs/pocl.md).
+#if MA_PIXEL_LANES > 0
+#define MA_CELL_LOOP _Pragma("clang loop vectorize_width(16)")
+#else
+#define MA_CELL_LOOP
+#endif
 #if defined(cl_khr_fp64)
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double ma_acc;  // per-pixel sums; free in the vectorised sampling kernel
@@ -45,6 +52,7 @@ typedef float ma_acc;
 typedef uint32_t ma_uint;
 typedef uint64_t ma_ulong;
 #define MA_UNROLL
+#define MA_CELL_LOOP
 typedef double ma_acc;
 // The OpenCL builtins as functions of float, as the kernels call them: each argument is
 // evaluated once, and nothing leaks out of namespace misalloc::kern.

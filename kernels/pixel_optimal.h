@@ -379,13 +379,16 @@ MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int 
 // Both kernels call it, one pixel a work-item.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
                                 float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
+  MA_CELL_LOOP
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
   zeroChunkSums(count, rows, stride);
   for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
+    MA_CELL_LOOP
     for (int j = 0; j < chunksFrom(count, first); ++j)
       addToChunkSums(count, j, storedCellMasses(cells, count, first + j, rows, stride), rows, stride);
   PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, envmapShare);
   for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
+    MA_CELL_LOOP
     for (int j = 0; j < chunksFrom(count, first); ++j)
       addToChunkEq6(count, j, eq6Term(rows, stride, count, first + j, t), rows, stride);
   if (shareColumns) pixelOptimalShareScales(count, rows, stride);
