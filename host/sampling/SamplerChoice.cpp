@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <iterator>
 #include <map>
+#include <vector>
 
 #include "Error.h"
 #include "sampling/HostSampler.h"
@@ -31,12 +32,16 @@ DeviceError explain(const cl::Error& e, const Device& device, const Scene& scene
   return explainBufferError(e, device, bufferOption(scene, config), scene.pixelCount());
 }
 
-// The envmap's sampling tables (and the pilot's, Scene::pilotTables) must fit the
-// device, each in one buffer: refused before they are uploaded, with the figures.
-void requireTablesFit(const Device& device, const Scene& scene) {
+// The envmap's sampling tables, and the pilot's where the config keeps statistics
+// (SceneBuffers), must fit the device, each in one buffer: refused before they are
+// uploaded, with the figures.
+void requireTablesFit(const Device& device, const Scene& scene, const SamplerConfig& config) {
   const EnvmapTables& t = scene.tables;
+  const EnvmapTables& pilot = stageTables(scene, keepsStatistics(config));
+  std::vector<const EnvmapTables*> uploaded{&t};
+  if (&pilot != &t) uploaded.push_back(&pilot);
   uint64_t largest = 0, total = 0;
-  for (const EnvmapTables* tables : {&t, &scene.pilotTables}) {
+  for (const EnvmapTables* tables : uploaded) {
     const uint64_t sizes[] = {tables->texels.size() * sizeof(float), tables->cdfTable.size() * sizeof(float),
                               tables->aliasTable.size() * sizeof(uint32_t), tables->blockProbs.size() * sizeof(float)};
     largest = std::max(largest, *std::max_element(std::begin(sizes), std::end(sizes)));
@@ -86,7 +91,7 @@ std::unique_ptr<StageSampler> makeDeviceSampler(const Device* device, const Scen
                                                 int localSize,
                                                 std::map<cl_context, std::shared_ptr<const SceneBuffers>>& shared) {
   if (!device) return std::make_unique<HostSampler>(scene, config);
-  requireTablesFit(*device, scene);
+  requireTablesFit(*device, scene, config);
   try {
     std::shared_ptr<const SceneBuffers>& buffers = shared[device->context()];
     if (!buffers) buffers = std::make_shared<SceneBuffers>(*device, scene, keepsStatistics(config));
