@@ -54,7 +54,10 @@ typedef struct {
 MA_FN MaVec3 latLongDirection(float u, float v) {
   MaSinCos theta = sinCos2Pi(0.5f * v);
   MaSinCos phi = sinCos2Pi(u);
-  return makeVec3(theta.s * phi.c, theta.s * phi.s, theta.c);
+  // y as an fma, the same product (docs/pocl.md, rule 8; frameToWorld): θ's and φ's
+  // sines and cosines, paired by the SLP vectoriser, kept the envmap technique's sample
+  // loop scalar on haswell.
+  return makeVec3(theta.s * phi.c, ma_fma(theta.s, phi.s, 0.0f), theta.c);
 }
 
 MA_FN int texelOfDirection(EnvmapView env, MaVec3 w) {

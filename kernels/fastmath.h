@@ -142,7 +142,9 @@ MA_FN float fastAcos(float x) {
 // atan2(y, x) mapped to [0, 2π): atan on [0, 1] by Abramowitz & Stegun 4.4.49
 // (|error| ≤ 2e-8), extended to all octants.
 MA_FN float fastAtan2Positive(float y, float x) {
-  float ax = ma_abs(x), ay = ma_abs(y);
+  // |y| as max(y, −y), not as |x| is: two like absolute values, paired by LLVM's SLP
+  // vectoriser, keep a sample loop scalar on PoCL's haswell target (docs/pocl.md, rule 8).
+  float ax = ma_abs(x), ay = ma_max(y, -y);
   float hi = ma_max(ma_max(ax, ay), 1e-30f);
   float t = ma_min(ax, ay) / hi;
   float t2 = t * t;

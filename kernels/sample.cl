@@ -70,7 +70,8 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
   StageCounts pixelCounts = loadStageCounts(counts, firstIndex, pixel, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                             MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
   __global const float* point = shadingPoints + shadingPointOffset(pixel);
-  MA_UNROLL
+  // Not unrolled: unrolled, its adjacent reads are paired by LLVM's SLP vectoriser on
+  // PoCL's haswell target, and the work-item loop stays scalar (docs/pocl.md, rule 8).
   for (int r = 0; r < MA_SHADING_POINT_WORDS; ++r) PIXEL_ROW(r) = as_int(point[r]);
   int countValues[ROW_COEFFICIENTS - ROW_N0] = {pixelCounts.n0,          pixelCounts.n1,
                                                 pixelCounts.n2,          (int)pixelCounts.first0,
