@@ -8,7 +8,8 @@
 # a fresh PoCL cache so that they compile, PoCL's remarks on.
 #
 # usage: sample_loops_vectorise.sh MISALLOC
-# Skipped (77) where the CPU has no AVX2 or PoCL no haswell kernel library.
+# Skipped (77) where the CPU has no AVX2, PoCL no haswell kernel library, or the CPU's
+# OpenCL device is not PoCL's.
 set -u
 misalloc=$1
 grep -qw avx2 /proc/cpuinfo || { echo "skipped: this CPU has no AVX2"; exit 77; }
@@ -20,10 +21,11 @@ for config in "--envmap-pdf plain" "--envmap-pdf optimal-pixel" "--envmap-pdf op
   mkdir -p "$work/cache"
   # shellcheck disable=SC2086
   if ! POCL_VECTORIZER_REMARKS=1 POCL_KERNELLIB_NAME=avx2 POCL_CACHE_DIR="$work/cache" "$misalloc" render \
-      --reference none --scene spheres --method equal $config --size 32x32 --spp 8 --out "$work/r.exr" \
+      --device cpu --reference none --scene spheres --method equal $config --size 32x32 --spp 8 --out "$work/r.exr" \
       --report "$work/r.json" --no-preview >"$work/log" 2>&1; then
     echo "FAIL: misalloc render $config failed:"; tail -5 "$work/log"; exit 1
   fi
+  grep -q '"device": "pthread' "$work/r.json" || { echo "skipped: the CPU's OpenCL device is not PoCL's"; exit 77; }
   grep -q "pthread-haswell" "$work/r.json" || { echo "FAIL: $config did not run on PoCL's haswell target"; exit 1; }
   vectorised=$(grep -o "vectorized loop (vectorization width" "$work/log" | wc -l)
   short=$(grep -o "instruction return type cannot be vectorized" "$work/log" | wc -l)
