@@ -22,8 +22,9 @@ namespace {
 
 // Changed whenever the entries' contents, their key or what a calibration times change:
 // older entries then miss. 2: stages launch only the pixels that take samples, and the
-// calibration times those.
-constexpr char kFormat[] = "misalloc cost model 2";
+// calibration times those. 3: the calibration's launches sized by their samples
+// (sampling/CostModel.cpp, calibrationSize).
+constexpr char kFormat[] = "misalloc cost model 3";
 
 // The envmap pdf's tables as the kernels read them, but the bank's bin of each pixel:
 // a band's tables hold its own rows' bins, which the image's BRDFs (the scene's part of

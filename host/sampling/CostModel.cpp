@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include "Error.h"
@@ -132,14 +133,50 @@ StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bo
   return plan;
 }
 
-// Samples per technique that make a launch of the covered pixels last about 10 ms, from
-// one launch of one sample per technique.
-int calibrationSize(StageSampler& sampler, int capacity) {
+// Samples per technique that make each technique's samples in a launch of the covered
+// pixels take about max(10 ms, the launch's fixed time), the most that `capacity`
+// allows, from launches of 1 and kProbe samples per technique. Sized by the whole
+// launch instead, the shapes took 1 and 4 samples: on a CPU one pass of 16 lanes
+// each, the same work, and where the fixed time dominates (the optimal pdf per pixel
+// builds every pixel's table in each launch) the fitted costs were its noise. One
+// cached calibration priced the BRDF technique's samples 8x below the envmap's, against
+// 1.5–1.8x measured again, and `exact` on its scene chose from it an allocation with
+// 2x `equal`'s error (docs/results.md).
+int calibrationSize(StageSampler& sampler, bool keepStatistics, int capacity) {
   const Scene& scene = sampler.scene();
-  StagePlan probe = calibrationPlan(scene, std::vector<int>(scene.techniqueCount(), 1), false);
-  const double seconds = sampler.run(probe, 0).kernelSeconds;
+  const int M = scene.techniqueCount();
+  // Past two passes of a CPU's 16 lanes, whose launches grow by whole passes.
+  constexpr int kProbe = 33;
+  const int probe = std::clamp(capacity, 1, kProbe);
+  const StagePlan one = calibrationPlan(scene, std::vector<int>(M, 1), keepStatistics),
+                  more = calibrationPlan(scene, std::vector<int>(M, probe), keepStatistics);
+  // The faster of two launches, after one not timed (a fresh process's first launches
+  // are slow, calibrateCostModel).
+  auto seconds = [&](const StagePlan& plan) {
+    double fastest = std::numeric_limits<double>::infinity();
+    for (int round = 0; round < 2; ++round) {
+      sampler.reset();
+      fastest = std::min(fastest, sampler.run(plan, 0).kernelSeconds);
+    }
+    return fastest;
+  };
+  auto slots = [&](const StagePlan& plan) {
+    const std::vector<double> s = sampler.launchWork(plan).slots;
+    return std::accumulate(s.begin(), s.end(), 0.0);
+  };
+  if (slots(more) == 0) return 1;  // no covered pixel: nothing to size
+  sampler.reset();
+  sampler.run(one, 0);
+  const double oneSeconds = seconds(one), moreSeconds = seconds(more), oneSlots = slots(one),
+               moreSlots = slots(more);
+  // At least an eighth of the time per slot of the launch of `probe` samples: noise on
+  // launches that hardly differ would otherwise size the shapes to minutes.
+  const double perSlot = std::max(moreSlots > oneSlots ? (moreSeconds - oneSeconds) / (moreSlots - oneSlots) : 0.0,
+                                  std::max(moreSeconds, 1e-9) / (8 * moreSlots));
+  const double fixed = std::max(oneSeconds - oneSlots * perSlot, 0.0);
+  const double perSample = perSlot * moreSlots / (probe * M);  // one technique's, on every covered pixel
   constexpr double kLaunchSeconds = 0.01;
-  return std::clamp(int(std::lround(kLaunchSeconds / std::max(seconds, 1e-6))), 1, std::max(1, capacity / 4));
+  return std::clamp(int(std::lround(std::max(kLaunchSeconds, fixed) / perSample)), 1, std::max(1, capacity / 4));
 }
 
 }  // namespace
@@ -148,15 +185,16 @@ CostModel calibrateCostModel(StageSampler& sampler) {
   const Scene& scene = sampler.scene();
   const int M = scene.techniqueCount();
   const bool withStatistics = keepsStatistics(sampler.config());
-  // A stage that keeps statistics stores its samples: the shapes fit in the slots.
-  const int capacity = withStatistics && sampler.config().sampleCapacity > 0 ? sampler.config().sampleCapacity
-                                                                             : std::numeric_limits<int>::max() / 8;
-  const int size = calibrationSize(sampler, capacity / M);
   std::vector<StagePlan> shapes;
-  // Each technique alone at two sizes, where the stored samples' slots allow.
-  const int large = std::min(4 * size, capacity / M);
   for (bool statistics : {false, true}) {
     if (statistics && !withStatistics) continue;
+    // A stage that keeps statistics stores its samples: its shapes fit in the slots.
+    const int capacity = (statistics && sampler.config().sampleCapacity > 0 ? sampler.config().sampleCapacity
+                                                                             : std::numeric_limits<int>::max() / 8) /
+                         M;
+    const int size = calibrationSize(sampler, statistics, capacity);
+    // Each technique alone at two sizes, where the stored samples' slots allow.
+    const int large = std::min(4 * size, capacity);
     for (int k = 0; k < M; ++k)
       for (int n : {size, large}) {
         if (n == large && large == size) continue;

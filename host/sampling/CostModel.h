@@ -77,8 +77,8 @@ class CostModel {
 // A model of `sampler`'s launches from calibration launches of a few shapes on every
 // pixel (each technique alone at two sizes, all together), interleaved over rounds so
 // that a drift of the machine's speed reaches every shape alike, on each kernel the
-// sampler has. They take about a tenth of a second on a 256×256 image; the sampler
-// is reset() afterwards.
+// sampler has, sized so that each technique's samples outweigh the launch's fixed time.
+// They take 1.5–4.5 s on a 256×256 image on two cores; the sampler is reset() afterwards.
 CostModel calibrateCostModel(StageSampler& sampler);
 
 // "--cost c1,c2[,c3]": one positive number per technique, else InputError.
