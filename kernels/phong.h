@@ -86,7 +86,7 @@ MA_FN MaFrame frameAbout(MaVec3 axis) {
 // y's sum in fmas, x's and z's in products: three like sums of a direction's
 // components are what LLVM's SLP vectoriser pairs into a 2-wide vector on PoCL's
 // haswell target (here, or wherever x and y meet later), which keeps the sample loop
-// scalar: 4.3x the BRDF technique's time (docs/pocl.md, rule 8).
+// scalar: 4.4x the BRDF technique's time (docs/pocl.md, rule 8).
 MA_FN MaVec3 frameToWorld(MaFrame f, float x, float y, float z) {
   return makeVec3(x * f.t.x + y * f.s.x + z * f.z.x, ma_fma(x, f.t.y, ma_fma(y, f.s.y, z * f.z.y)),
                   x * f.t.z + y * f.s.z + z * f.z.z);

@@ -164,11 +164,11 @@ int calibrationSize(StageSampler& sampler, bool keepStatistics, int capacity) {
     const std::vector<double> s = sampler.launchWork(plan).slots;
     return std::accumulate(s.begin(), s.end(), 0.0);
   };
-  if (slots(more) == 0) return 1;  // no covered pixel: nothing to size
+  const double oneSlots = slots(one), moreSlots = slots(more);
+  if (moreSlots == 0) return 1;  // no covered pixel: nothing to size
   sampler.reset();
   sampler.run(one, 0);
-  const double oneSeconds = seconds(one), moreSeconds = seconds(more), oneSlots = slots(one),
-               moreSlots = slots(more);
+  const double oneSeconds = seconds(one), moreSeconds = seconds(more);
   // At least an eighth of the time per slot of the launch of `probe` samples: noise on
   // launches that hardly differ would otherwise size the shapes to minutes.
   const double perSlot = std::max(moreSlots > oneSlots ? (moreSeconds - oneSeconds) / (moreSlots - oneSlots) : 0.0,
@@ -188,10 +188,11 @@ CostModel calibrateCostModel(StageSampler& sampler) {
   std::vector<StagePlan> shapes;
   for (bool statistics : {false, true}) {
     if (statistics && !withStatistics) continue;
-    // A stage that keeps statistics stores its samples: its shapes fit in the slots.
-    const int capacity = (statistics && sampler.config().sampleCapacity > 0 ? sampler.config().sampleCapacity
-                                                                             : std::numeric_limits<int>::max() / 8) /
-                         M;
+    // Samples per technique a launch may take: a stage that keeps statistics stores
+    // its samples, and its shapes fit in the slots.
+    const int slots = statistics && sampler.config().sampleCapacity > 0 ? sampler.config().sampleCapacity
+                                                                        : std::numeric_limits<int>::max() / 8;
+    const int capacity = slots / M;
     const int size = calibrationSize(sampler, statistics, capacity);
     // Each technique alone at two sizes, where the stored samples' slots allow.
     const int large = std::min(4 * size, capacity);
