@@ -34,10 +34,15 @@ typedef ulong ma_ulong;
 #define MA_UNROLL _Pragma("unroll")
 // A loop over a pixel's cells within one work-item (samplePixelStage's lanes, a CPU's)
 // at the float16 width: LLVM prefers 256-bit vectors on AVX-512 CPUs (docs/pocl.md).
+// MA_CELL_GATHER_LOOP: such a loop that reads the rows at a stride and writes others,
+// which LLVM cannot tell apart without a check it does not build: the rows it reads and
+// those it writes are asserted disjoint.
 #if MA_PIXEL_LANES > 0
 #define MA_CELL_LOOP _Pragma("clang loop vectorize_width(16)")
+#define MA_CELL_GATHER_LOOP _Pragma("clang loop vectorize(assume_safety) vectorize_width(16)")
 #else
 #define MA_CELL_LOOP
+#define MA_CELL_GATHER_LOOP
 #endif
 #if defined(cl_khr_fp64)
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
@@ -53,6 +58,7 @@ typedef uint32_t ma_uint;
 typedef uint64_t ma_ulong;
 #define MA_UNROLL
 #define MA_CELL_LOOP
+#define MA_CELL_GATHER_LOOP
 typedef double ma_acc;
 // The OpenCL builtins as functions of float, as the kernels call them: each argument is
 // evaluated once, and nothing leaks out of namespace misalloc::kern.

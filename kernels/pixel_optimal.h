@@ -264,13 +264,6 @@ MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, 
 // entry is 1. The envmap's CDF, or the product's (product). A chunk's running
 // state is plain floats, no struct: a struct of floats carried by a loop is a short
 // vector, which keeps PoCL's loop scalar (docs/pocl.md, rule 11).
-MA_FN float chunkCdfOffset(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
-                           PixelTableScales s, int product) {
-  float offset = 0.0f;
-  for (int i = 0; i < j; ++i) offset += chunkTableMass(rows, stride, count, i, t, s, product);
-  return offset;
-}
-
 MA_FN float chunkCdfNext(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
                          PixelTableScales s, int product, float offset) {
   return ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
@@ -286,35 +279,51 @@ MA_FN int cdfFirstRow(int count, int product) { return product ? MA_PRODUCT_CDF_
 
 MA_FN int cdfEntryRow(int count, int p, int product) { return cdfFirstRow(count, product) + p + 1; }
 
-// Where pass 4 keeps each cell's table mass, in the cells' order: the envmap table's
-// masses in the rows of the cells' f, which nothing reads after them; the product's,
-// built first, in the rows of the envmap's CDF, which is written after them.
+// Where pass 4 keeps each cell's partial sum, in the cells' order: the envmap table's in
+// the rows of the cells' f, which nothing reads after them; the product's, built
+// first, in the rows of the envmap's CDF, which is written after them.
 MA_FN int cellMassRow(int count, int c, int product) { return product ? MA_CDF_ROW(c) : MA_F_ROW(count, c); }
 
-// Pass 4a, over the cells in their order, side by side, so that a compiler may
-// vectorise it: each cell's table mass.
-MA_FN void pixelOptimalCellMasses(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, PixelTableScales s,
-                                  int product, MA_LOCAL int* rows, int stride) {
-  for (int c = 0; c < count; ++c)
-    setRowFloat(rows, stride, cellMassRow(count, c, product),
-                cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN)));
+// Pass 4a, over the cells in turns of one cell of each chunk, as passes 2 and 3 run,
+// so that a compiler may vectorise across the chunks: each cell's table mass, added to
+// its chunk's partial sum, which is kept in place of the mass. Each chunk's sum adds
+// its cells in increasing order, as a loop over the chunk would.
+MA_FN void pixelOptimalPartialSums(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, PixelTableScales s,
+                                   int product, MA_LOCAL int* rows, int stride) {
+  float partial[MA_PIXEL_CHUNKS];
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) partial[j] = 0.0f;
+  for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
+    MA_CELL_LOOP
+    for (int j = 0; j < chunksFrom(count, first); ++j) {
+      int c = first + j;
+      partial[j] += cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
+      setRowFloat(rows, stride, cellMassRow(count, c, product), partial[j]);
+    }
 }
 
-// Pass 4b, per chunk, two loops over its entries: the partial sums of its cells'
-// masses, which carry a value from cell to cell, then the entries, which a compiler
+// Pass 4b, per chunk: its entries from the partial sums of its cells, which a compiler
 // may vectorise.
-MA_FN void pixelOptimalChunkCdf(int count, int j, PixelOptimalTerms t, PixelTableScales s, int product,
-                                MA_LOCAL int* rows, int stride) {
-  float offset = chunkCdfOffset(rows, stride, count, j, t, s, product);
-  float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset), partial = 0.0f;
+MA_FN void chunkCdfEntries(int count, int j, float offset, float next, int product, MA_LOCAL int* rows, int stride) {
   int first = chunkStart(count, j), length = chunkLength(count, j), row = cdfEntryRow(count, first, product);
+  MA_CELL_GATHER_LOOP
   for (int i = 0; i < length; ++i) {
-    partial += rowFloat(rows, stride, cellMassRow(count, i * MA_PIXEL_CHUNKS + j, product));
-    setRowFloat(rows, stride, row + i, partial);
+    float partial = rowFloat(rows, stride, cellMassRow(count, i * MA_PIXEL_CHUNKS + j, product));
+    setRowFloat(rows, stride, row + i, chunkCdfEntry(count, first + i, offset, partial, next));
   }
-  for (int i = 0; i < length; ++i)
-    setRowFloat(rows, stride, row + i, chunkCdfEntry(count, first + i, offset, rowFloat(rows, stride, row + i), next));
-  if (j == 0) setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
+}
+
+// The whole of pass 4: the offset of chunk j is the sum of the chunks' table masses
+// before it, added in order.
+MA_FN void pixelOptimalCdf(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, PixelTableScales s,
+                           int product, MA_LOCAL int* rows, int stride) {
+  pixelOptimalPartialSums(cells, count, t, s, product, rows, stride);
+  float offset = 0.0f;
+  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
+    float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset);
+    chunkCdfEntries(count, j, offset, next, product, rows, stride);
+    offset += chunkTableMass(rows, stride, count, j, t, s, product);
+  }
+  setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
 }
 
 // The share columns' share s of MA_MAX_BANK_SHARES: C_s = (s+1)/(shares+1), the bank's
@@ -395,11 +404,9 @@ MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongPa
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
   if (productCdf) {
     ProductCdfTerms p = productCdfTerms(rows, stride, count);
-    pixelOptimalCellMasses(cells, count, p.t, p.s, 1, rows, stride);
-    for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(count, j, p.t, p.s, 1, rows, stride);
+    pixelOptimalCdf(cells, count, p.t, p.s, 1, rows, stride);
   }
-  pixelOptimalCellMasses(cells, count, t, s, 0, rows, stride);
-  for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) pixelOptimalChunkCdf(count, j, t, s, 0, rows, stride);
+  pixelOptimalCdf(cells, count, t, s, 0, rows, stride);
 }
 
 // The product technique's view of the pixel's cells: the envmap's, over the product's CDF.

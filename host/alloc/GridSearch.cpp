@@ -561,6 +561,18 @@ void GridSearch::reset() {
   device_.queue.finish();
 }
 
+// The prepared samples' buffer is kept from run to run: a new one costs the kernel a
+// page fault per 4 KiB, and page faults do not scale across threads.
+void GridSearch::reserve(int samples) {
+  const std::size_t floats =
+      std::max<std::size_t>(1, paddedPixelCount(std::size_t(pixelCount_)) * std::size_t(samples) * (columns_.count() + 1));
+  if (floats <= preparedFloats_) return;
+  prepared_ = cl::Buffer(device_.context, CL_MEM_READ_WRITE, floats * sizeof(float));
+  device_.queue.enqueueFillBuffer(prepared_, cl_uchar(0), 0, floats * sizeof(float));
+  device_.queue.finish();
+  preparedFloats_ = floats;
+}
+
 GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLayout& layout,
                                  const std::vector<double>& costs, GridRule rule,
                                  const std::optional<PooledSelection>& pooling) {
@@ -580,13 +592,7 @@ GridSearchResult GridSearch::run(const cl::Buffer& samples, const StoredSampleLa
   };
   LaneGrid lanes = laneGrid(grid);
   cl::Buffer gridLanes = upload(lanes.alpha), gridCost = upload(lanes.cost), cost = upload(toFloats(costs));
-  // The prepared samples' buffer is kept from run to run: a new one costs the kernel
-  // a page fault per 4 KiB, and page faults do not scale across threads.
-  std::size_t preparedFloats = std::max<std::size_t>(1, paddedPixelCount(std::size_t(pixels)) * layout.taken * (m + 1));
-  if (preparedFloats > preparedFloats_) {
-    prepared_ = cl::Buffer(device_.context, CL_MEM_READ_WRITE, preparedFloats * sizeof(float));
-    preparedFloats_ = preparedFloats;
-  }
+  reserve(layout.taken);
   cl::Buffer alphaOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * m * sizeof(float));
   cl::Buffer selectedOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_int));
   cl::Buffer fallbacksOut(device_.context, CL_MEM_WRITE_ONLY, std::size_t(pixels) * sizeof(cl_uint));

@@ -129,6 +129,10 @@ class GridSearch {
                        const std::optional<PooledSelection>& pooling = std::nullopt);
   // Forgets the samples added so far.
   void reset();
+  // Makes and writes the buffer that searches of up to `samples` taken per pixel prepare
+  // their samples in, so that the first does not pay its page faults, as the sums' and
+  // scores' buffers are written when the search is made.
+  void reserve(int samples);
 
  private:
   const Device& device_;

@@ -41,6 +41,7 @@ KeptGridSearch& keptSearch(StageStatistics& stages) {
       kept->device =
           std::make_unique<GridSearch>(*device, sampleColumns(scene, config), scene.pixelCount(), config.gridSize,
                                        config.runningSums, ranksOptimalWeights(stages), scene.surfaces);
+      kept->device->reserve(config.sampleCapacity);
     } catch (const cl::Error& e) {
       // The grid's sums and scores are the search's largest buffers.
       throw explainBufferError(e, *device, fmt::format("--grid-u {}", config.gridSize), scene.pixelCount());

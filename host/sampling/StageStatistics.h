@@ -96,7 +96,9 @@ SamplerConfig plainConfig(SamplerConfig config);
 SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config);
 
 // Padding lanes of the stored samples: column 0, f = 0 and every pdf 1, so that the
-// grid search may read them as samples that contribute nothing.
+// grid search may read them as samples that contribute nothing. Written over `floats`
+// floats from `out`, whole rows of 16 lanes from a record's first, in one pass.
+void writeEmptyStoredSamples(float* out, std::size_t floats, int columns);
 std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config);
 
 }  // namespace misalloc
