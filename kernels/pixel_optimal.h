@@ -264,11 +264,7 @@ MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, 
 // entry is 1. The envmap's CDF, or the product's (product). A chunk's running
 // state is plain floats, no struct: a struct of floats carried by a loop is a short
 // vector, which keeps PoCL's loop scalar (docs/pocl.md, rule 11).
-MA_FN float chunkCdfNext(MA_LOCAL const int* rows, int stride, int count, int j, PixelOptimalTerms t,
-                         PixelTableScales s, int product, float offset) {
-  return ceilToUniformGrid(ma_min(offset + chunkTableMass(rows, stride, count, j, t, s, product), 1.0f));
-}
-
+//
 // The entry after the cell at CDF position p, given its chunk's offset, next and
 // partial sum up to that cell.
 MA_FN float chunkCdfEntry(int count, int p, float offset, float partial, float next) {
@@ -319,9 +315,9 @@ MA_FN void pixelOptimalCdf(MA_GLOBAL const float* cells, int count, PixelOptimal
   pixelOptimalPartialSums(cells, count, t, s, product, rows, stride);
   float offset = 0.0f;
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) {
-    float next = chunkCdfNext(rows, stride, count, j, t, s, product, offset);
-    chunkCdfEntries(count, j, offset, next, product, rows, stride);
-    offset += chunkTableMass(rows, stride, count, j, t, s, product);
+    float end = offset + chunkTableMass(rows, stride, count, j, t, s, product);
+    chunkCdfEntries(count, j, offset, ceilToUniformGrid(ma_min(end, 1.0f)), product, rows, stride);
+    offset = end;
   }
   setRowFloat(rows, stride, cdfFirstRow(count, product), 0.0f);
 }

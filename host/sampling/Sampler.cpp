@@ -35,19 +35,6 @@ void writeSums(const Device& d, const cl::Buffer& buffer, const std::vector<doub
   d.queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, raw.size() * sizeof(Acc), raw.data());
 }
 
-// The stored samples, empty (emptyStoredSamples), followed by the spare record that the
-// kernel's lanes store a sample they do not keep into (kernels/stats.h,
-// spareSampleIndex): written once at their full size, and copied once. (Written in
-// place, through a map or in memory the buffer uses, it saved the copy, but PoCL 3.1
-// then spent 0.03–0.05 s more of the render's host time on it.)
-cl::Buffer emptyStoredSampleBuffer(const Device& d, const Scene& scene, const SamplerConfig& config) {
-  const int columns = sampleColumns(scene, config).count();
-  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), columns, config.sampleCapacity, 0}.floatCount() +
-                             size_t(MA_SAMPLE_RECORD_FLOATS(columns)) * 16);
-  writeEmptyStoredSamples(samples.data(), samples.size(), columns);
-  return upload(d, samples, CL_MEM_READ_WRITE);
-}
-
 // The rows of the larger of the two sampling kernels, which share a launch shape.
 int largestPixelRows(const Scene& scene, const SamplerConfig& config) {
   return std::max(samplePixelRows(scene, config), samplePixelRows(scene, plainConfig(config)));
@@ -175,7 +162,11 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   const size_t slots = std::max<size_t>(1, size_t(scene.pixelCount()) * statSlots());
   stats_ = cl::Buffer(device.context, CL_MEM_READ_WRITE, slots * accSize);
   device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
-  samples_ = config.sampleCapacity > 0 ? emptyStoredSampleBuffer(device, scene, config)
+  // The stored samples, then the spare record that the kernel's lanes store a sample they
+  // do not keep into (kernels/stats.h, spareSampleIndex), copied once. (Written in place,
+  // through a map or in memory the buffer uses, they saved the copy, but PoCL 3.1 then
+  // spent 0.03–0.05 s more of the render's host time on them.)
+  samples_ = config.sampleCapacity > 0 ? upload(device, emptyStoredSamples(scene, config, 1), CL_MEM_READ_WRITE)
                                        : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
   // Each buffer's size is the offset of the pixel past the last (kernels/pixel_layout.h).
   const int pixels = scene.pixelCount(), M = scene.techniqueCount();

@@ -63,19 +63,15 @@ SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config) {
   return SampleColumns(M, config.shareColumns && fits ? shares : 0);
 }
 
-void writeEmptyStoredSamples(float* out, std::size_t floats, int columns) {
-  const int rows = MA_SAMPLE_RECORD_FLOATS(columns);
+std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config, int spareRecords) {
+  const int columns = sampleColumns(scene, config).count(), rows = MA_SAMPLE_RECORD_FLOATS(columns);
+  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), columns, config.sampleCapacity, 0}.floatCount() +
+                             std::size_t(spareRecords) * rows * 16);
   int q = 0;  // the value each row of 16 lanes holds (kernels/stats.h, storedSampleIndex)
-  for (std::size_t row = 0; row < floats / 16; ++row) {
-    std::fill_n(out + row * 16, 16, q < 2 ? 0.0f : 1.0f);
+  for (std::size_t row = 0; row < samples.size() / 16; ++row) {
+    std::fill_n(samples.begin() + row * 16, 16, q < 2 ? 0.0f : 1.0f);
     q = q + 1 < rows ? q + 1 : 0;
   }
-}
-
-std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config) {
-  const int columns = sampleColumns(scene, config).count();
-  std::vector<float> samples(StoredSampleLayout{scene.pixelCount(), columns, config.sampleCapacity, 0}.floatCount());
-  writeEmptyStoredSamples(samples.data(), samples.size(), columns);
   return samples;
 }
 

@@ -96,9 +96,8 @@ SamplerConfig plainConfig(SamplerConfig config);
 SampleColumns sampleColumns(const Scene& scene, const SamplerConfig& config);
 
 // Padding lanes of the stored samples: column 0, f = 0 and every pdf 1, so that the
-// grid search may read them as samples that contribute nothing. Written over `floats`
-// floats from `out`, whole rows of 16 lanes from a record's first, in one pass.
-void writeEmptyStoredSamples(float* out, std::size_t floats, int columns);
-std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config);
+// grid search may read them as samples that contribute nothing; then `spareRecords`
+// records of 16 lanes more, alike. Written once, at their full size.
+std::vector<float> emptyStoredSamples(const Scene& scene, const SamplerConfig& config, int spareRecords = 0);
 
 }  // namespace misalloc
