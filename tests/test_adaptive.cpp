@@ -28,7 +28,8 @@ Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed,
   options.imageGainBelow = imageGainBelow;
   options.stages = stages;
   options.oracleSamples = 128;
-  const auto sampler = sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
+  const auto sampler =
+      sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options, scene.techniqueCount()));
   return render(*sampler, method, options, spp, seed);
 }
 
@@ -118,7 +119,7 @@ TEST_CASE("grid-search renders on the C++ reference sampler take the device's co
     AdaptiveOptions options;
     options.costs.assign(scene.techniqueCount(), 1.0);
     options.oracleSamples = 128;
-    SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, 60, options);
+    SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, 60, options, scene.techniqueCount());
     Sampler device(testDevice(), scene, config);
     HostSampler host(scene, config);
     Rendering a = render(device, m, options, 60, 5), b = render(host, m, options, 60, 5);
@@ -193,7 +194,8 @@ TEST_CASE("the pilot weighs less where the neighbours predict that alpha beats e
   Scene constant = smallScene("constant", "uniform:1,0,1", 24, 16);
   AdaptiveOptions options;
   options.costs = {1.0, 1.0};
-  Sampler sampler(testDevice(), constant, samplerConfigFor(Method::Exact, Estimator::MultiSample, 100, options));
+  Sampler sampler(testDevice(), constant,
+                  samplerConfigFor(Method::Exact, Estimator::MultiSample, 100, options, constant.techniqueCount()));
   Rendering pooled = render(sampler, Method::Exact, options, 100, 9);
   CHECK(pooled.meanPilotWeight < 0.5 * 0.05);
   options.poolRadius = 0;
@@ -251,7 +253,8 @@ TEST_CASE("exact keeps equal counts for the whole image where its held-out pilot
   AdaptiveOptions own;
   own.costs = {1.0, 1.0};
   own.poolRadius = 0;
-  Sampler sampler(testDevice(), flat, samplerConfigFor(Method::Exact, Estimator::MultiSample, 100, own));
+  Sampler sampler(testDevice(), flat,
+                  samplerConfigFor(Method::Exact, Estimator::MultiSample, 100, own, flat.techniqueCount()));
   Rendering unpredicted = render(sampler, Method::Exact, own, 100, 3);
   CHECK_FALSE(unpredicted.predictedGain);
   CHECK_FALSE(unpredicted.keptEqualCounts);

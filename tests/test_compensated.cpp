@@ -51,7 +51,7 @@ Rendering renderWith(const Scene& scene, Method method, Estimator estimator, int
   options.costs.assign(scene.techniqueCount(), 1.0);
   options.oracleSamples = 128;
   requireValidRun(scene.options, method, estimator, spp, options);
-  const auto sampler = sweepSampler(scene, samplerConfigFor(method, estimator, spp, options));
+  const auto sampler = sweepSampler(scene, samplerConfigFor(method, estimator, spp, options, scene.techniqueCount()));
   return render(*sampler, method, options, spp, seed);
 }
 

@@ -222,7 +222,8 @@ TEST_CASE("a render calibrates its sampler's model and predicts every stage", "[
   AdaptiveOptions options;
   options.stages = 2;
   const int spp = 64;
-  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, spp, options));
+  Sampler sampler(testDevice(), scene,
+                  samplerConfigFor(Method::Exact, Estimator::MultiSample, spp, options, scene.techniqueCount()));
   const Rendering r = render(sampler, Method::Exact, options, spp, 1);
   REQUIRE(r.costModel);
   CHECK_FALSE(r.costModel->isGiven());
@@ -257,7 +258,8 @@ TEST_CASE("a render calibrates its sampler's model and predicts every stage", "[
 TEST_CASE("fixed splits are timed but not predicted", "[costmodel]") {
   const Scene scene = smallScene("cosk:4", "seed000", 32, 32);
   AdaptiveOptions options;
-  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options));
+  Sampler sampler(testDevice(), scene,
+                  samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options, scene.techniqueCount()));
   const Rendering r = render(sampler, Method::Equal, options, 16, 1);
   REQUIRE(r.stages.size() == 1);
   CHECK_FALSE(r.stages[0].predictedKernelSeconds);
@@ -286,7 +288,8 @@ TEST_CASE("the cost cache calibrates a sampler once and hands every later one th
   const std::string cache = (dir.path / "cache").string();
   const Scene scene = smallScene("cosk:4", "seed000", 32, 32);
   AdaptiveOptions options;
-  const SamplerConfig config = samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, options);
+  const SamplerConfig config =
+      samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, options, scene.techniqueCount());
   Sampler first(testDevice(), scene, config);
   provideCostModel(first, scene, {cache, false});
   CHECK(first.costModel().source() == CostSource::Calibrated);
@@ -340,7 +343,8 @@ TEST_CASE("the cost cache calibrates a sampler once and hands every later one th
     const Scene other = smallScene("cosk:2", "seed000", 32, 32);
     Sampler onOther(testDevice(), other, config);
     CHECK(costCacheKey(onOther, other) != costCacheKey(first, scene));
-    Sampler heuristic(testDevice(), scene, samplerConfigFor(Method::Heuristic, Estimator::MultiSample, 32, options));
+    Sampler heuristic(testDevice(), scene,
+                      samplerConfigFor(Method::Heuristic, Estimator::MultiSample, 32, options, scene.techniqueCount()));
     CHECK(costCacheKey(heuristic, scene) != costCacheKey(first, scene));
     HostSampler host(scene, config);
     CHECK(costCacheKey(host, scene) != costCacheKey(first, scene));
@@ -352,7 +356,9 @@ TEST_CASE("a cost cache that cannot be written leaves the render its own calibra
   const std::string blocked = (dir.path / "not-a-folder").string();
   std::ofstream(blocked) << "a file where the cache's folder would be";
   const Scene scene = smallScene("cosk:4", "seed000", 16, 16);
-  Sampler sampler(testDevice(), scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, AdaptiveOptions{}));
+  Sampler sampler(
+      testDevice(), scene,
+      samplerConfigFor(Method::Exact, Estimator::MultiSample, 32, AdaptiveOptions{}, scene.techniqueCount()));
   provideCostModel(sampler, scene, {blocked, false});
   CHECK(sampler.costModel().source() == CostSource::Calibrated);
   CHECK(std::filesystem::is_regular_file(blocked));

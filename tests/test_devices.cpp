@@ -36,7 +36,8 @@ AdaptiveOptions fixedCosts(const Scene& scene) {
 
 Rendering renderOn(SamplerDevices& devices, const Scene& scene, Method method, Estimator estimator, int spp) {
   AdaptiveOptions options = fixedCosts(scene);
-  auto sampler = devices.makeSampler(scene, samplerConfigFor(method, estimator, spp, options), 8);
+  auto sampler =
+      devices.makeSampler(scene, samplerConfigFor(method, estimator, spp, options, scene.techniqueCount()), 8);
   return render(*sampler, method, options, spp, 11);
 }
 
@@ -135,7 +136,7 @@ TEST_CASE("a failed device's tiles run again on the others: the same image", "[d
   int injected = 0;
   for (Method method : {Method::Equal, Method::Heuristic, Method::Exact}) {
     AdaptiveOptions options = fixedCosts(scene);
-    const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 48, options);
+    const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, 48, options, scene.techniqueCount());
     Sampler single(testDevice(), scene, config);
     Rendering expected = render(single, method, options, 48, 5);
     // Fails at its second tile: in the pilot of the adaptive methods, after it ran a
@@ -159,7 +160,8 @@ TEST_CASE("a failed device's tiles run again on the others: the same image", "[d
 TEST_CASE("with every device failed the render stops with a DeviceError", "[devices]") {
   const Scene scene = smallScene("studio_small_03", "seed000", 40, 26);
   AdaptiveOptions options = fixedCosts(scene);
-  const SamplerConfig config = samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options);
+  const SamplerConfig config =
+      samplerConfigFor(Method::Equal, Estimator::MultiSample, 16, options, scene.techniqueCount());
   auto tiled = withFailingMember(scene, config, {1, 1});
   CHECK_THROWS_WITH(render(*tiled, Method::Equal, options, 16, 5),
                     Catch::Contains("every device failed") && Catch::Contains("injected failure"));

@@ -119,7 +119,8 @@ MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, 
 MeanAndError resampledMean(const Scene& scene, int spp, uint64_t seed) {
   AdaptiveOptions options;
   options.risCandidates = 3;
-  HostSampler sampler(scene, samplerConfigFor(Method::Ris, Estimator::MultiSample, spp, options));
+  HostSampler sampler(scene,
+                      samplerConfigFor(Method::Ris, Estimator::MultiSample, spp, options, scene.techniqueCount()));
   return pixelMean(sampler.run(singleStagePlan(scene, Method::Ris, spp), seed).rgb);
 }
 
@@ -229,7 +230,8 @@ TEST_CASE("the product technique from the pixel's cells is unbiased in frames of
     addSized(family, where + ": exact", expected, 64, 64, ++seed, [&](int spp, uint64_t sd) {
       AdaptiveOptions options;
       options.costs.assign(3, 1.0);
-      const auto sampler = sweepSampler(scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, spp, options));
+      const auto sampler = sweepSampler(
+          scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, spp, options, scene.techniqueCount()));
       const Rendering r = render(*sampler, Method::Exact, options, spp, sd);
       return pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
     });

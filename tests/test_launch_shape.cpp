@@ -29,7 +29,8 @@ DeviceLimits gpu(size_t maxWorkGroupSize = 1024, uint64_t localMemBytes = k48KiB
 // The running sums of a method's sampler on a scene of M techniques.
 int statSlotsOf(Method method, bool split) {
   Scene scene = smallScene("cosk:3", "uniform:0.5,0.5,10", 4, 4, split);
-  HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, 64, AdaptiveOptions{}));
+  HostSampler sampler(scene,
+                      samplerConfigFor(method, Estimator::MultiSample, 64, AdaptiveOptions{}, scene.techniqueCount()));
   return sampler.statSlots();
 }
 
@@ -163,7 +164,8 @@ TEST_CASE("launch shape: sampleKernelLocalBytes is what PoCL allocates for the b
     if (pixelPdf) REQUIRE(scene.tables.pixelCells > 0);
     AdaptiveOptions options;
     options.weights = optimal ? MisWeights::Optimal : MisWeights::Balance;
-    SamplerConfig config = samplerConfigFor(methods[method], Estimator::MultiSample, 64, options);
+    SamplerConfig config =
+        samplerConfigFor(methods[method], Estimator::MultiSample, 64, options, scene.techniqueCount());
     const int statSlots = HostSampler(scene, config).statSlots();
     const int pixelRows = samplePixelRows(scene, config);
     CAPTURE(split, product, methodName(methods[method]), optimal, pixelPdf, localSize);

@@ -72,7 +72,8 @@ Rendering renderOptimal(const Scene& scene, Method method, int spp, uint64_t see
                         MisWeights weights = MisWeights::Optimal) {
   AdaptiveOptions options = optimalOptions(scene.techniqueCount());
   options.weights = weights;
-  const auto sampler = sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
+  const auto sampler =
+      sweepSampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options, scene.techniqueCount()));
   return render(*sampler, method, options, spp, seed);
 }
 

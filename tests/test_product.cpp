@@ -347,7 +347,8 @@ TEST_CASE("the α map's picture shows the product technique's share in green", "
   const Scene scene = makeScene(productSphere("optimal-pixel"));
   AdaptiveOptions options;
   options.costs = {1, 1, 1};
-  HostSampler sampler(scene, samplerConfigFor(Method::Exact, Estimator::MultiSample, 64, options));
+  HostSampler sampler(scene,
+                      samplerConfigFor(Method::Exact, Estimator::MultiSample, 64, options, scene.techniqueCount()));
   const Rendering r = render(sampler, Method::Exact, options, 64, 3);
   const std::vector<uint8_t> picture = decodePng(encodeAlphaMaps(scene, r).png).rgb;
   size_t misdrawn = 0, covered = 0, green = 0;
@@ -381,7 +382,7 @@ TEST_CASE("under a black map the product falls back with the optimal pdf per pix
   for (Method method : {Method::Equal, Method::Exact}) {
     AdaptiveOptions options;
     options.costs = {1, 1, 1};
-    HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, 32, options));
+    HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, 32, options, scene.techniqueCount()));
     const Rendering r = render(sampler, method, options, 32, 5);
     size_t nonZero = 0;
     for (float v : r.image.rgb) nonZero += v != 0.0f;

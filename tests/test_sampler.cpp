@@ -344,7 +344,8 @@ TEST_CASE("resampled sampling on PoCL matches its C++ reference bit for bit", "[
   for (const std::string map : {"rooitou_park", "cosk:2"})
     for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf}) {
       const Scene scene = smallScene(map, "seed000", 24, 16, false, s);
-      const SamplerConfig config = samplerConfigFor(Method::Ris, Estimator::MultiSample, 50, AdaptiveOptions{});
+      const SamplerConfig config =
+          samplerConfigFor(Method::Ris, Estimator::MultiSample, 50, AdaptiveOptions{}, scene.techniqueCount());
       Sampler device(testDevice(), scene, config);
       HostSampler host(scene, config);
       const StagePlan plan = singleStagePlan(scene, Method::Ris, 50);
@@ -363,8 +364,10 @@ TEST_CASE("one candidate resampled is envmap sampling", "[sampler][ris]") {
   const Scene scene = smallScene("rooitou_park", "seed000", 24, 16);
   AdaptiveOptions options;
   options.risCandidates = 1;
-  HostSampler resampled(scene, samplerConfigFor(Method::Ris, Estimator::MultiSample, 32, options));
-  HostSampler envmap(scene, samplerConfigFor(Method::Envmap, Estimator::MultiSample, 32, options));
+  HostSampler resampled(scene,
+                        samplerConfigFor(Method::Ris, Estimator::MultiSample, 32, options, scene.techniqueCount()));
+  HostSampler envmap(scene,
+                     samplerConfigFor(Method::Envmap, Estimator::MultiSample, 32, options, scene.techniqueCount()));
   StageResult a = resampled.run(singleStagePlan(scene, Method::Ris, 32), 3);
   StageResult b = envmap.run(singleStagePlan(scene, Method::Envmap, 32), 3);
   size_t apart = 0;

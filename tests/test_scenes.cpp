@@ -160,7 +160,7 @@ TEST_CASE("background pixels take no samples and count in no error, whatever the
     options.oracleSamples = 32;
     options.stages = 2;
     options.weights = run.weights;
-    HostSampler sampler(scene, samplerConfigFor(run.method, run.estimator, 40, options));
+    HostSampler sampler(scene, samplerConfigFor(run.method, run.estimator, 40, options, scene.techniqueCount()));
     const Rendering r = render(sampler, run.method, options, 40, 7);
     CHECK(r.image.alpha == scene.geometry.alpha());
     size_t sampledBackground = 0, nonZeroBackground = 0, uncounted = 0;
@@ -222,7 +222,8 @@ TEST_CASE("under a constant map every covered pixel of a sphere is rho_d, throug
     options.costs.assign(2, 1.0);
     addSized(family, methodName(method), 0.6, 16, 8, ++seed, [&](int spp, uint64_t sd) {
       spp = std::max(spp, 16);
-      HostSampler sampler(scene, samplerConfigFor(method, Estimator::MultiSample, spp, options));
+      HostSampler sampler(scene,
+                          samplerConfigFor(method, Estimator::MultiSample, spp, options, scene.techniqueCount()));
       return coveredMean(render(sampler, method, options, spp, sd).image);
     });
   }

@@ -90,7 +90,7 @@ TEST_CASE("every schedule of a small budget is refused or unbiased against [HS14
         ++refused;
         continue;
       }
-      HostSampler sampler(scene, samplerConfigFor(s.method, s.estimator, s.spp, options));
+      HostSampler sampler(scene, samplerConfigFor(s.method, s.estimator, s.spp, options, scene.techniqueCount()));
       Rendering r = render(sampler, s.method, options, s.spp, seed);
       MeanAndError mean = pixelMean(std::vector<double>(r.image.rgb.begin(), r.image.rgb.end()));
       rendered.push_back({fmt::format("{}: mean {} expected {}", describe(scene, s), mean.mean, expected),

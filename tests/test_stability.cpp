@@ -47,7 +47,7 @@ Rendering renderWith(const Scene& scene, Method method, int spp, uint64_t seed, 
   AdaptiveOptions options;
   options.costs = costs.empty() ? std::vector<double>(scene.techniqueCount(), 1.0) : costs;
   options.oracleSamples = 128;
-  const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, spp, options);
+  const SamplerConfig config = samplerConfigFor(method, Estimator::MultiSample, spp, options, scene.techniqueCount());
   const std::unique_ptr<StageSampler> sampler =
       deviceLocalSize > 0 ? std::make_unique<Sampler>(testDevice(), scene, config, deviceLocalSize)
                           : sweepSampler(scene, config);

@@ -68,8 +68,10 @@ TEST_CASE("a pooled allocation beside another surface is the allocation without 
     options.costs = {1.0, 1.5};
     options.stages = 2;
     const int spp = 48;
-    Sampler onBeside(testDevice(), beside, samplerConfigFor(method, Estimator::MultiSample, spp, options));
-    Sampler onAlone(testDevice(), alone, samplerConfigFor(method, Estimator::MultiSample, spp, options));
+    Sampler onBeside(testDevice(), beside,
+                     samplerConfigFor(method, Estimator::MultiSample, spp, options, beside.techniqueCount()));
+    Sampler onAlone(testDevice(), alone,
+                    samplerConfigFor(method, Estimator::MultiSample, spp, options, alone.techniqueCount()));
     const Rendering a = render(onBeside, method, options, spp, 3), b = render(onAlone, method, options, spp, 3);
     int differ = 0;
     for (int y = 0; y < height; ++y)

@@ -36,7 +36,8 @@ MeanAndError renderMean(const Scene& scene, Method method, Estimator estimator, 
 MeanAndError resampledMean(const Scene& scene, int candidates, int spp, uint64_t seed) {
   AdaptiveOptions options;
   options.risCandidates = candidates;
-  HostSampler sampler(scene, samplerConfigFor(Method::Ris, Estimator::MultiSample, spp, options));
+  HostSampler sampler(scene,
+                      samplerConfigFor(Method::Ris, Estimator::MultiSample, spp, options, scene.techniqueCount()));
   return pixelMean(sampler.run(singleStagePlan(scene, Method::Ris, spp), seed).rgb);
 }
 

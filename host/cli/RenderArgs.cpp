@@ -69,7 +69,7 @@ RenderPlan RenderArgs::plan(const Scene& s) const {
   options.weights = parseMisWeights(weights, "--weights");
   requireValidRun(s.options, m, e, spp, options);
   requireStatisticsMemory(s.options, {m}, "--spp", spp, options, devices.onHost(), devices.samplerCount());
-  return {m, options, samplerConfigFor(m, e, spp, options)};
+  return {m, options, samplerConfigFor(m, e, spp, options, s.techniqueCount())};
 }
 
 std::optional<Reference> RenderArgs::referenceFile(const Scene& s) const {

@@ -18,7 +18,7 @@ struct MemoryNeed {
 void appendStatisticsMemory(std::vector<MemoryNeed>& needs, const SceneOptions& scene, Method m,
                             const std::string& sppOption, int spp, const AdaptiveOptions& adaptive, bool onHost,
                             int samplers) {
-  const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive);
+  const SamplerConfig config = samplerConfigFor(m, Estimator::MultiSample, spp, adaptive, scene.techniqueCount());
   const double pixels = double(scene.width) * scene.height;
   // The columns of every share of an optimal pdf, the bank's or per pixel (sampleColumns),
   // from the options alone: at most what the scene's tables give.

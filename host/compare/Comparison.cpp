@@ -213,7 +213,8 @@ Comparison runComparison(const CompareOptions& options, InterruptionGuard& guard
       std::vector<std::unique_ptr<StageSampler>> samplers;
       for (Method method : methods) {
         samplers.push_back(devices.makeSampler(
-            scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive), options.localSize));
+            scene, samplerConfigFor(method, Estimator::MultiSample, budget, adaptive, scene.techniqueCount()),
+            options.localSize));
         if (isAdaptive(method) && adaptive.costs.empty())
           provideCostModel(*samplers.back(), plainScene, {options.cacheDir, adaptive.measureCosts});
       }

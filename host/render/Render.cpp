@@ -165,22 +165,18 @@ std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
   return sameCountsEverywhere(pixels, apportionCounts(std::vector<double>(M, 1.0), stageSamples));
 }
 
-// The largest stage that keeps statistics (all but the last) whatever the technique
-// count M, which the sampler config does not know: the largest of the pilots of every
-// M, and of the stages after the pilot of M = 2, which are largest after the smallest
-// pilot.
-int largestStatisticsStage(const AdaptiveOptions& options, int spp) {
-  std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, 2);
+// The largest stage that keeps statistics (all but the last), of the stages of the
+// scene's technique count M: the grid searches store its samples.
+int largestStatisticsStage(const AdaptiveOptions& options, int spp, int techniqueCount) {
+  std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, techniqueCount);
   sizes.pop_back();
-  int largest = *std::max_element(sizes.begin(), sizes.end());
-  for (int M = 2; M <= kMaxTechniques; ++M)
-    largest = std::max(largest, std::min(spp, pilotSamples(options.pilotFraction, spp, M)));
-  return largest;
+  return *std::max_element(sizes.begin(), sizes.end());
 }
 
 }  // namespace
 
-SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options) {
+SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options,
+                               int techniqueCount) {
   const MethodTraits& traits = methodTraits(method);
   SamplerConfig config;
   config.estimator = traits.fixesEstimator() ? traits.estimator : fixedSplitEstimator;
@@ -195,7 +191,7 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
     // The grid searches keep running sums: the samples of one stage at a time are
     // stored, and the last stage stores none (the oracle's: its probe only).
     config.sampleCapacity =
-        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp);
+        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp, techniqueCount);
     config.gridSize = options.gridSize;
     config.runningSums = traits.split == Split::Staged && options.stages > 1;
     // Rule (b) judges each α_0 by the pdf of the share it would run (WeightGrid).

@@ -105,6 +105,9 @@ struct Rendering {
 // needs (samplerConfigFor); whatever it took before is forgotten (StageSampler::reset).
 Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& options, int spp, uint64_t seed);
 
-SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options);
+// What a sampler keeps for `method` in a scene of `techniqueCount` techniques: its stored
+// samples are sized for that count's stages.
+SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int spp, const AdaptiveOptions& options,
+                               int techniqueCount);
 
 }  // namespace misalloc

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <type_traits>
 
 #include "Constants.h"
 #include "KernelCode.h"
@@ -22,11 +23,16 @@ cl::Buffer upload(const Device& d, const std::vector<T>& data, cl_mem_flags flag
 }
 
 // Sums are double where the device has it (ma_acc in kernels/common.h), else float.
+// Doubles are read into the vector returned: a copy would fault in a second vector's
+// fresh pages in the render's time (about 10 µs a page at its first write on a VM).
 template <typename Acc>
 std::vector<double> readSums(const Device& d, const cl::Buffer& buffer, size_t first, size_t count) {
   std::vector<Acc> raw(count);
   d.queue.enqueueReadBuffer(buffer, CL_TRUE, first * sizeof(Acc), count * sizeof(Acc), raw.data());
-  return std::vector<double>(raw.begin(), raw.end());
+  if constexpr (std::is_same_v<Acc, double>)
+    return raw;
+  else
+    return std::vector<double>(raw.begin(), raw.end());
 }
 
 template <typename Acc>

@@ -98,7 +98,7 @@ std::set<Variant> hostVariants() {
                 } catch (const InputError&) {
                   continue;
                 }
-                SamplerConfig config = samplerConfigFor(method, estimator, 64, options);
+                SamplerConfig config = samplerConfigFor(method, estimator, 64, options, s.techniqueCount());
                 for (int localSize : {8, 256}) {
                   variants.insert({"sample.cl", sampleKernelOptions(s, config, localSize)});
                   variants.insert({"sample.cl", sampleKernelOptions(s, plainConfig(config), localSize)});
