@@ -170,8 +170,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
   device.queue.enqueueFillBuffer(stats_, cl_uchar(0), 0, slots * accSize);
   // The stored samples, then the spare record that the kernel's lanes store a sample they
   // do not keep into (kernels/stats.h, spareSampleIndex), copied once. (Written in place,
-  // through a map or in memory the buffer uses, they saved the copy, but PoCL 3.1 then
-  // spent 0.03–0.05 s more of the render's host time on them.)
+  // through a map, in memory the buffer uses or by a kernel, they saved the copy, but the
+  // render then took 0.02–0.05 s more host time: docs/results.md, "Stored samples sized
+  // by the scene's techniques".)
   samples_ = config.sampleCapacity > 0 ? upload(device, emptyStoredSamples(scene, config, 1), CL_MEM_READ_WRITE)
                                        : cl::Buffer(device.context, CL_MEM_READ_WRITE, sizeof(float));
   // Each buffer's size is the offset of the pixel past the last (kernels/pixel_layout.h).
