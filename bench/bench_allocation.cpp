@@ -72,7 +72,7 @@ void renderAndTime(benchmark::State& state, StageSampler& sampler, Method method
 }
 
 SamplerConfig benchSamplerConfig(Method method) {
-  return samplerConfigFor(method, Estimator::MultiSample, config.spp, benchOptions());
+  return samplerConfigFor(method, Estimator::MultiSample, config.spp, benchOptions(), benchScene().techniqueCount());
 }
 
 void benchOpenCl(benchmark::State& state, Method method) {

@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
                "imbalance (median, of wall) |\n|---|---|---|---|---|---|\n";
   for (const std::string& name : CLI::detail::split(methodList, ',')) {
     const Method method = parseMethod(name);
-    const SamplerConfig sc = samplerConfigFor(method, Estimator::MultiSample, spp, adaptive);
+    const SamplerConfig sc = samplerConfigFor(method, Estimator::MultiSample, spp, adaptive, scene.techniqueCount());
     std::map<std::string, std::unique_ptr<StageSampler>> samplers;
     for (const auto& c : configs) samplers[c] = makeSampler(c, scene, sc, keep);
     std::map<std::string, Timing> t;

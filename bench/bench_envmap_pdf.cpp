@@ -50,7 +50,7 @@ void benchRender(benchmark::State& state, const std::string& map, const std::str
   o.width = o.height = 256;
   o.envmapPdf = parseEnvmapPdf(pdf);
   const Scene scene = makeScene(o);
-  Sampler sampler(device, scene, samplerConfigFor(Method::Equal, Estimator::MultiSample, 200, {}));
+  Sampler sampler(device, scene, samplerConfigFor(Method::Equal, Estimator::MultiSample, 200, {}, scene.techniqueCount()));
   render(sampler, Method::Equal, {}, 200, 1);  // warm-up
   uint64_t seed = 2;
   for (auto _ : state) benchmark::DoNotOptimize(render(sampler, Method::Equal, {}, 200, seed++));

@@ -96,7 +96,7 @@ AdaptiveOptions benchOptions(const Scene& scene) {
 }
 
 std::unique_ptr<StageSampler> makeSampler(Peer peer, const Device* device, const Scene& scene, Method method) {
-  SamplerConfig c = samplerConfigFor(method, Estimator::MultiSample, config.spp, benchOptions(scene));
+  SamplerConfig c = samplerConfigFor(method, Estimator::MultiSample, config.spp, benchOptions(scene), scene.techniqueCount());
   if (peer == Peer::OpenCl) return std::make_unique<Sampler>(*device, scene, c);
   return std::make_unique<HostSampler>(scene, c);
 }

@@ -112,8 +112,8 @@ Scene benchScene(EnvmapSampler sampler) {
 }
 
 // What a render of the variant's method builds: ris its own estimator.
-SamplerConfig configOf(const Variant& v) {
-  return samplerConfigFor(v.method, Estimator::MultiSample, config.spp, AdaptiveOptions{});
+SamplerConfig configOf(const Variant& v, const Scene& scene) {
+  return samplerConfigFor(v.method, Estimator::MultiSample, config.spp, AdaptiveOptions{}, scene.techniqueCount());
 }
 
 const Device& device() {
@@ -161,7 +161,7 @@ double largestRelativeDifference(const std::vector<double>& a, const std::vector
 // kPeerAgreement per pixel: a faster peer that computes something else compares nothing.
 void checkAgainstReference(const Variant& v, const Scene& scene, const bench::VectorisedPeer& peer,
                            const StagePlan& plan) {
-  HostSampler reference(scene, configOf(v));
+  HostSampler reference(scene, configOf(v, scene));
   const StageResult expected = reference.run(plan, 1), got = peer.run(plan, 1);
   const bool sameSizes = expected.rgb.size() == got.rgb.size() && expected.moments.size() == got.moments.size();
   const double estimates = sameSizes ? largestRelativeDifference(expected.rgb, got.rgb) : NAN;
@@ -179,13 +179,13 @@ void checkAgainstReference(const Variant& v, const Scene& scene, const bench::Ve
 
 void benchOpenCl(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  Sampler sampler(device(), scene, configOf(v));
+  Sampler sampler(device(), scene, configOf(v, scene));
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 
 void benchOpenMp(benchmark::State& state, const Variant& v) {
   Scene scene = benchScene(v.sampler);
-  HostSampler sampler(scene, configOf(v));
+  HostSampler sampler(scene, configOf(v, scene));
   runStages(state, sampler, singleStagePlan(scene, v.method, config.spp));
 }
 
