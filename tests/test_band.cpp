@@ -18,11 +18,13 @@ using namespace misalloc::test;
 namespace {
 
 // A 16×40 image: three bands of 16, 16 and 8 rows; given costs, the same on every node.
+// exact's whole-image rule off, in the bands and the unsharded render alike: it decides
+// from the whole image, and a band refuses it (the refusals below).
 std::string renderArgs(const fs::path& dir, const std::string& method, const std::string& extra) {
   return fmt::format(
-      "render --envmap sun --size 16x40 --spp 48 --method {} --cost 1,1.5 --device cpu --reference none --no-preview "
-      "--report {} {}",
-      method, (dir / "report.json").string(), extra);
+      "render --envmap sun --size 16x40 --spp 48 --method {}{} --cost 1,1.5 --device cpu --reference none "
+      "--no-preview --report {} {}",
+      method, method == "exact" ? " --skip-image-below 0" : "", (dir / "report.json").string(), extra);
 }
 
 std::string bandPath(const fs::path& dir, int k) { return (dir / fmt::format("band{}.exr", k)).string(); }
@@ -144,6 +146,11 @@ TEST_CASE("merge refuses bands that do not make one run's image, and writes noth
        {merge + b0 + " " + b1 + " " + (dir.path / "plain.exr").string(), "not a band of a sharded render"},
        {merge + b0 + " " + b1 + " " + b2 + " --out " + b1, "--out"},
        {renderArgs(dir.path, "exact", "--shard 3/3 --out x.exr"), "--shard '3/3'"},
+       // The whole-image rule on (the default): each band would decide from its own rows.
+       {fmt::format("render --envmap sun --size 16x40 --spp 48 --device cpu --reference none --no-preview "
+                    "--shard 0/3 --out {}",
+                    (dir.path / "x.exr").string()),
+        "whole-image rule"},
        {renderArgs(dir.path, "equal", "--shard 0/4 --out x.exr"), "fewer than the 4 bands"}},
       dir.path / "m.exr");
 }
@@ -156,8 +163,8 @@ TEST_CASE("bands without --cost allocate with the cost cache's one calibration",
   // image's: the first band calibrates, the others and the whole render read it.
   auto render = [&](const std::string& cache, const std::string& extra, const std::string& out) {
     auto r = runMisalloc(fmt::format(
-        "render --envmap sun --size 16x40 --spp 48 --method exact --device cpu --reference none --no-preview "
-        "--cache-dir {} --report {} --out {} {}",
+        "render --envmap sun --size 16x40 --spp 48 --method exact --skip-image-below 0 --device cpu --reference none "
+        "--no-preview --cache-dir {} --report {} --out {} {}",
         (dir.path / cache).string(), (dir.path / "report.json").string(), (dir.path / out).string(), extra));
     INFO(r.output);
     REQUIRE(r.exitCode == 0);

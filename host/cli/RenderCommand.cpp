@@ -44,10 +44,19 @@ void refuseBandOutputs(RenderCommandArgs& args) {
   args.noPreview = true;
 }
 
-// A sharded render's band (render/Band.h), checked before any work.
+// A sharded render's band (render/Band.h), checked before any work. exact's whole-image
+// rule decides from every pixel's pilot, which a band does not see: bands that decided
+// apart would not merge into the unsharded image.
 std::optional<Band> requestedBand(const RenderCommandArgs& args, const RenderPlan& plan, int height) {
   if (args.shard.empty()) return std::nullopt;
-  return bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(plan.method, plan.adaptive));
+  Band band = bandOf(parseShard(args.shard, "--shard"), height, poolingHaloRows(plan.method, plan.adaptive));
+  if (plan.method == Method::Exact && plan.adaptive.imageGainBelow > 0)
+    throw InputError(fmt::format(
+        "--shard with --method exact: the whole-image rule (--skip-image-below {}) decides from the whole image's "
+        "pilot, which a band does not see; give --skip-image-below 0 (the rule off) to every band and to the "
+        "unsharded render they are compared with",
+        plan.adaptive.imageGainBelow));
+  return band;
 }
 
 // A band's run identity: the run's, and the costs it allocated with. Bands that share a

@@ -106,7 +106,7 @@ echo "slurm: one node ($node) idle"
 export MISALLOC=$misalloc
 out=$scratch/out
 cache="--cache-dir $scratch/cache"
-render="--envmap sun --size 16x40 --spp 32 --method exact --stages 2 --cost 1,1.5 --device cpu --reference none"
+render="--envmap sun --size 16x40 --spp 32 --method exact --skip-image-below 0 --stages 2 --cost 1,1.5 --device cpu --reference none"
 compare="--suite --size 8x8 --methods equal,exact --budgets 16 --repeats 1 --cost 1,1.5 --reference-spp 64 --device cpu"
 
 "$misalloc" render $render --no-preview --out "$scratch/whole.exr" --report "$scratch/whole.json" >/dev/null
