@@ -2,11 +2,11 @@
 // share C, built at run time: every pixel may see the map differently (a real scene),
 // and C is the pixel's own α_0. The map is cut into coarse cells, blocks of 2^L × 2^L
 // texels (host/distributions/EnvmapDistribution.h, buildPixelOptimalEnvmapTables), each
-// with its centre, its share of the plain pdf's mass, its solid angle and its spread.
-// Per pixel and stage, f = L ρ cos and the BRDF technique's p_ρ are taken at each
-// cell's centre, their Phong lobe and cosine averaged over the cell (cellLobe,
-// cellCosine), and the cells weighed by eq. 6, max(0, f − (1−C) p_ρ) with both
-// normalised: eq. 9 at its bound s = 1/C, which the optimal pdf's bank measures within
+// with two frames (a mean direction and a spread: its own, and its light's), its share
+// of the plain pdf's mass and its solid angle. Per pixel and stage, f = L ρ cos is taken
+// at each cell's light and the BRDF technique's p_ρ over the cell, their Phong lobe and
+// cosine averaged over the frame's spread (cellLobe, cellCosine), and the cells weighed
+// by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its bound s = 1/C, which the optimal pdf's bank measures within
 // a few percent of eq. 9's variance (render.json, one_sample_variance_eq6_over_eq9_mean).
 // A share of the plain pdf keeps every lit cell drawable (the cells' means are
 // estimates: a cell weighed 0 may hold lit texels above the horizon). The pixel's CDF
@@ -38,12 +38,28 @@
 #include "phong.h"
 #include "pixel_layout.h"
 
-// A cell's floats: its centre's direction x, y, z, its share of the plain pdf's mass,
-// its solid angle, and its spread as a lobe's exponent (cellLobe). Each float of every
-// cell in turn (field f of cell c at cells[f · count + c]), so that a pass over cells
-// side by side reads each float side by side.
-enum { CELL_X, CELL_Y, CELL_Z, CELL_PLAIN, CELL_SOLID_ANGLE, CELL_SPREAD };
-#define MA_CELL_FLOATS 6
+// A cell's floats: two frames (CellFrame, host: EnvmapDistribution.cpp, cellFrames),
+// each a mean direction x, y, z and a spread about it as a lobe's exponent (cellLobe):
+// the cell's, its directions weighed by solid angle, where the BRDF technique's mass
+// in it lies; and its light's, its texels weighed as its alias table draws them, where
+// f's mass lies (a sun in a cell's corner is there, not at the cell's centre), the
+// cell's own where it holds no light. Then its share of the plain pdf's mass and its
+// solid angle. Each float of every cell in turn (field f of cell c at
+// cells[f · count + c]), so that a pass over cells side by side reads each float side
+// by side.
+enum {
+  CELL_X,
+  CELL_Y,
+  CELL_Z,
+  CELL_SPREAD,
+  CELL_LIGHT_X,
+  CELL_LIGHT_Y,
+  CELL_LIGHT_Z,
+  CELL_LIGHT_SPREAD,
+  CELL_PLAIN,
+  CELL_SOLID_ANGLE
+};
+#define MA_CELL_FLOATS 10
 // The plain pdf's share of the pixel's table: the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
@@ -78,49 +94,65 @@ MA_FN void addToRowFloat(MA_LOCAL int* rows, int stride, int r, float v) {
   setRowFloat(rows, stride, r, rowFloat(rows, stride, r) + v);
 }
 
+// Directions about a mean `centre`, spread as a cos^κ lobe about it, κ = `spread`.
 typedef struct {
   MaVec3 centre;
-  float plain, solidAngle, spread;
+  float spread;
+} CellFrame;
+
+typedef struct {
+  CellFrame area;   // CELL_X … CELL_SPREAD: p_ρ's mass is taken there
+  CellFrame light;  // CELL_LIGHT_X … CELL_LIGHT_SPREAD: f's mass is taken there
+  float plain, solidAngle;
 } PixelCell;
 
 MA_FN float cellField(MA_GLOBAL const float* cells, int count, int c, int field) { return cells[field * count + c]; }
 
+// The frame whose fields start at `first` (CELL_X or CELL_LIGHT_X).
+MA_FN CellFrame cellFrameAt(MA_GLOBAL const float* cells, int count, int c, int first) {
+  CellFrame f;
+  f.centre = makeVec3(cellField(cells, count, c, first), cellField(cells, count, c, first + 1),
+                      cellField(cells, count, c, first + 2));
+  f.spread = cellField(cells, count, c, first + 3);
+  return f;
+}
+
 MA_FN PixelCell pixelCellAt(MA_GLOBAL const float* cells, int count, int c) {
   PixelCell cell;
-  cell.centre = makeVec3(cellField(cells, count, c, CELL_X), cellField(cells, count, c, CELL_Y),
-                         cellField(cells, count, c, CELL_Z));
+  cell.area = cellFrameAt(cells, count, c, CELL_X);
+  cell.light = cellFrameAt(cells, count, c, CELL_LIGHT_X);
   cell.plain = cellField(cells, count, c, CELL_PLAIN);
   cell.solidAngle = cellField(cells, count, c, CELL_SOLID_ANGLE);
-  cell.spread = cellField(cells, count, c, CELL_SPREAD);
   return cell;
 }
 
-// The Phong lobe averaged over a cell rather than taken at its centre: a lobe narrower
-// than the cell would otherwise weigh the cell by its tail at the centre, and a glossy
-// pixel's table would miss the cell that holds its lobe. cos^κ spreads a direction by
-// 1/κ per axis; the cell's κ is the inverse of its directions' second moment about its
-// centre along its wider axis (θ or φ: a cell at a pole is a narrow wedge), so that
-// cos^n about the mirror direction spread by the cell is cos^κ' with 1/κ' = 1/n + 1/κ
-// (variances add), scaled by (κ'+1)/(n+1) so that the lobe keeps its mass 2π/(n+1).
-MA_FN float cellLobe(PhongParams b, PixelCell cell, MaVec3 mirror) {
+// The Phong lobe averaged over a frame's directions rather than taken at its centre: a
+// lobe narrower than a cell would otherwise weigh the cell by its tail at the centre,
+// and a glossy pixel's table would miss the cell that holds its lobe. cos^κ spreads a
+// direction by 1/κ per axis; a frame's κ is the inverse of its directions' second
+// moment about their mean along their wider axis (a cell at a pole is a narrow wedge),
+// so that cos^n about the mirror direction spread by the frame is cos^κ' with
+// 1/κ' = 1/n + 1/κ (variances add), scaled by (κ'+1)/(n+1) so that the lobe keeps its
+// mass 2π/(n+1).
+MA_FN float cellLobe(PhongParams b, CellFrame frame, MaVec3 mirror) {
   PhongParams spread = b;
-  spread.n = b.n / (1.0f + b.n / cell.spread);  // κ = ∞ (a cell of one texel) spreads nothing
-  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, cell.centre, mirror);
+  spread.n = b.n / (1.0f + b.n / frame.spread);
+  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, frame.centre, mirror);
 }
 
-// max(0, cos θ) averaged over a cell rather than taken at its centre, so that a cell
-// that straddles the horizon keeps the part above it: the angle above the horizon
-// spread uniformly by ±w about the centre's, w = √(3/κ) (the cell's spread), in its
-// small-angle form: the centre's value where the cell lies wholly above, 0 below.
-MA_FN float cellCosine(MaVec3 normal, PixelCell cell) {
-  float c = dot3(normal, cell.centre), w = ma_sqrt(3.0f / cell.spread);
+// max(0, cos θ) averaged over a frame's directions rather than taken at its centre, so
+// that a cell that straddles the horizon keeps the part above it: the angle above the
+// horizon spread uniformly by ±w about the centre's, w = √(3/κ) (the frame's spread), in
+// its small-angle form: the centre's value where the frame lies wholly above, 0 below.
+MA_FN float cellCosine(MaVec3 normal, CellFrame frame) {
+  float c = dot3(normal, frame.centre), w = ma_sqrt(3.0f / frame.spread);
   float straddling = (c + w) * (c + w) / (4.0f * w);
   return c >= w ? c : c > -w ? straddling : 0.0f;
 }
 
-// f's mass at cell c: its plain mass times ρ and cos, each averaged over the cell.
+// f's mass at cell c: its plain mass times ρ and cos, each averaged over the cell's light.
 MA_FN float cellIntegrand(PixelCell cell, PhongParams b, MaVec3 normal, MaVec3 mirror) {
-  return cell.plain * phongBrdf(b, cellLobe(b, cell, mirror)) * cellCosine(normal, cell);
+  return cell.plain * phongBrdf(b, cellLobe(b, cell.light, mirror)) * cellCosine(normal, cell.light);
 }
 
 // A cell's f, p_ρ and plain masses; a chunk's sums of them, its cells added in
@@ -135,7 +167,7 @@ MA_FN CellMasses pixelCellMasses(MA_GLOBAL const float* cells, int count, int c,
   PixelCell cell = pixelCellAt(cells, count, c);
   CellMasses m;
   m.f = cellIntegrand(cell, b, normal, mirror);
-  m.q = cell.solidAngle * brdfPdfOf(b, cellCosine(normal, cell), cellLobe(b, cell, mirror));
+  m.q = cell.solidAngle * brdfPdfOf(b, cellCosine(normal, cell.area), cellLobe(b, cell.area, mirror));
   m.plain = cell.plain;
   return m;
 }

@@ -681,7 +681,7 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
   EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(misalloc::makeEnvmap("constant", 1024), 16);
   REQUIRE(tables.pixelCells == 16 * 8);
   auto cell = [&](int c) { return kern::pixelCellAt(tables.blockProbs.data(), tables.pixelCells, c); };
-  auto centre = [&](int c) { return cell(c).centre; };
+  auto centre = [&](int c) { return cell(c).area.centre; };
   auto normalised = [](double x, double y, double z) {
     double r = std::sqrt(x * x + y * y + z * z);
     return kern::makeVec3(float(x / r), float(y / r), float(z / r));
@@ -703,7 +703,7 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
       INFO("mirror " << mirror.x << ", " << mirror.y << ", " << mirror.z);
       double mass = 0;
       for (int k = 0; k < tables.pixelCells; ++k)
-        mass += double(cell(k).solidAngle) * kern::cellLobe(brdf, cell(k), mirror);
+        mass += double(cell(k).solidAngle) * kern::cellLobe(brdf, cell(k).area, mirror);
       const double ratio = mass / (2 * kPi / (double(n) + 1));
       if (n <= 10.0f)
         CHECK(std::abs(ratio - 1) <= 0.1);
@@ -711,15 +711,17 @@ TEST_CASE("the optimal pdf per pixel weighs a Phong lobe by its mass over a cell
         CHECK((ratio >= 0.3 && ratio <= 2.5));
     }
   }
-  // On every test map, down to cells of one texel (no spread), the lobe is a number.
+  // On every test map, down to cells of one texel, under either frame, the lobe is a number.
   for (const auto& [name, map] : testMaps()) {
     INFO(name);
     EnvmapTables small = misalloc::buildPixelOptimalEnvmapTables(map);
     for (int k = 0; k < small.pixelCells; ++k)
       for (float n : {0.0f, 1.0f, 1e5f}) {
         const kern::PixelCell c = kern::pixelCellAt(small.blockProbs.data(), small.pixelCells, k);
-        const float lobe = kern::cellLobe({0.0f, 1.0f, n}, c, c.centre);
-        CHECK((std::isfinite(lobe) && lobe > 0.0f));
+        for (const kern::CellFrame& frame : {c.area, c.light}) {
+          const float lobe = kern::cellLobe({0.0f, 1.0f, n}, frame, frame.centre);
+          CHECK((std::isfinite(lobe) && lobe > 0.0f));
+        }
       }
   }
 }
@@ -752,14 +754,58 @@ TEST_CASE("the optimal pdf per pixel weighs cos θ by its mean over a cell, the 
     for (int k = 0; k < tables.pixelCells; ++k) {
       const kern::PixelCell cell = kern::pixelCellAt(tables.blockProbs.data(), tables.pixelCells, k);
       const double exact = mean[std::size_t(k)] / weight[std::size_t(k)];
-      errorMean += cell.solidAngle * std::abs(kern::cellCosine(normal, cell) - exact);
-      errorCentre += cell.solidAngle * std::abs(std::max(0.0f, kern::dot3(normal, cell.centre)) - exact);
+      errorMean += cell.solidAngle * std::abs(kern::cellCosine(normal, cell.area) - exact);
+      errorCentre += cell.solidAngle * std::abs(std::max(0.0f, kern::dot3(normal, cell.area.centre)) - exact);
     }
     CHECK(errorMean / kPi <= 0.025);
     totalMean += errorMean;
     totalCentre += errorCentre;
   }
   CHECK(totalMean <= 0.8 * totalCentre);
+}
+
+TEST_CASE("the optimal pdf per pixel takes f's mass at a cell's light and p_ρ's over the cell", "[envmap][optimal]") {
+  // buildPixelOptimalEnvmapTables, cellFrames: a patch of 2 × 2 texels 10⁴ times brighter
+  // than the rest, in a corner of a cell 16 texels wide, and a lobe narrower than the
+  // cell (n = 10³) aimed at the patch. Against the sums over the cell's texels: f's mass
+  // (cellIntegrand; their plain masses times ρ and cos), within 2×, and p_ρ's
+  // (pixelCellMasses' q; their solid angles times p_ρ), within 4× (0.35×: a lobe at a
+  // cell's corner is no Gaussian of the cell's spread). f's mass at the cell's centre
+  // and size misses the patch by two orders of magnitude (0.01×: its corner lies 0.25
+  // rad from the centre, in the lobe's far tail); p_ρ's mass at the light's frame is the
+  // lobe's peak over the whole cell, far too much, which clips the cell from the
+  // pixel's table (eq. 6) where BRDF sampling covers only a part of it.
+  const int width = 256, height = 128, row0 = 48, col0 = 80;
+  auto bright = [&](int col, int row) { return (row == row0 || row == row0 + 1) && (col == col0 || col == col0 + 1); };
+  const Envmap map = greyMap(width, height, [&](int col, int row) { return bright(col, row) ? 1e4f : 1.0f; });
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map, 16);
+  REQUIRE(tables.blockLog2 == 4);
+  const int cellIndex = (row0 >> 4) * (width >> 4) + (col0 >> 4);
+  const kern::PixelCell cell = kern::pixelCellAt(tables.blockProbs.data(), tables.pixelCells, cellIndex);
+  const kern::MaVec3 patch = kern::latLongDirection(float(col0 + 1) / width, float(row0 + 1) / height);
+  // The light's centre within a texel (π/128 = 0.025 rad) of the patch's.
+  CHECK(kern::dot3(cell.light.centre, patch) >= std::cos(kPi / height));
+  double plainTotal = 0, f = 0, q = 0;
+  const kern::PhongParams brdf = {0.0f, 1.0f, 1e3f};
+  const double texelArea = (2 * kPi / width) * (kPi / height);
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col) {
+      const double sinTheta = std::sin(kPi * (row + 0.5) / height);
+      const double weight = (bright(col, row) ? 1e4 : 1.0) * sinTheta;
+      plainTotal += weight;
+      if (row >> 4 != row0 >> 4 || col >> 4 != col0 >> 4) continue;
+      const kern::MaVec3 w = kern::latLongDirection(float((col + 0.5) / width), float((row + 0.5) / height));
+      const float lobe = kern::phongLobe(brdf, w, patch), cosine = std::max(0.0f, kern::dot3(patch, w));
+      f += weight * kern::phongBrdf(brdf, lobe) * cosine;
+      q += sinTheta * texelArea * kern::brdfPdfOf(brdf, cosine, lobe);
+    }
+  f /= plainTotal;
+  const kern::CellMasses masses =
+      kern::pixelCellMasses(tables.blockProbs.data(), tables.pixelCells, cellIndex, brdf, patch, patch);
+  INFO("f: the cell's over the texels' " << masses.f / f << "; p_ρ: " << masses.q / q);
+  CHECK(masses.f == kern::cellIntegrand(cell, brdf, patch, patch));
+  CHECK((masses.f / f >= 0.5 && masses.f / f <= 2.0));
+  CHECK((masses.q / q >= 0.25 && masses.q / q <= 4.0));
 }
 
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -19,13 +20,6 @@ namespace misalloc {
 namespace {
 
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
-
-// Texel i's centre less the centre of its cell's texels, in texels, along an axis of n
-// texels cut into cells of `side` (the last cell may be shorter).
-double offsetFromCellCentre(int i, int side, int n) {
-  const int first = i / side * side;
-  return i + 0.5 - (first + 0.5 * std::min(side, n - first));
-}
 
 void requireValidSize(const Envmap& envmap) {
   const RgbImage& image = envmap.image;
@@ -366,27 +360,60 @@ int pixelCellLog2(int width, int height, int cellsAcross) {
 
 namespace {
 
-// Per cell of 2^log2 texels a side, given its solid angle: the exponent κ of a cos^κ
-// lobe as wide as the cell along its wider axis, the inverse of the second moment of
-// its directions about its centre along θ or along φ (arc lengths), whichever is larger
-// (kernels/pixel_optimal.h, cellLobe); ∞ for a cell of one texel.
-std::vector<float> cellSpreads(int width, int height, int log2, const std::vector<double>& solidAngle) {
-  const int side = 1 << log2, across = (width + side - 1) / side;
-  std::vector<double> theta(solidAngle.size(), 0.0), phi(solidAngle.size(), 0.0);
-  const double texelArea = (2 * kPi / width) * (kPi / height);
+// Per cell of 2^log2 texels a side, its frame (kernels/pixel_optimal.h, CellFrame) under
+// the texels' weights `weightOf(row, col)`: the weighed mean of their directions, and
+// the exponent κ = 1/σ² of a cos^κ lobe as wide as they are along their wider axis (σ²
+// the larger eigenvalue of their weighed second moment in the plane tangent to the
+// mean), a texel's own extent (its θ-side²/12) added. A cell whose texels all weigh 0
+// gets no frame (spread 0).
+template <typename WeightOf>
+std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightOf weightOf) {
+  const int side = 1 << log2, across = (width + side - 1) / side, down = (height + side - 1) / side;
+  const std::size_t cells = std::size_t(across) * down;
+  std::vector<double> sinTheta(static_cast<std::size_t>(height)), cosTheta(sinTheta.size());
+  std::vector<double> sinPhi(static_cast<std::size_t>(width)), cosPhi(sinPhi.size());
   for (int row = 0; row < height; ++row) {
-    const double sinTheta = sinThetaOfRow(row, height), dOmega = sinTheta * texelArea;
-    const double dTheta = kPi / height * offsetFromCellCentre(row, side, height);
-    for (int col = 0; col < width; ++col) {
-      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
-      const double dPhi = 2 * kPi / width * offsetFromCellCentre(col, side, width) * sinTheta;
-      theta[cell] += dOmega * dTheta * dTheta;
-      phi[cell] += dOmega * dPhi * dPhi;
-    }
+    sinTheta[std::size_t(row)] = sinThetaOfRow(row, height);
+    cosTheta[std::size_t(row)] = std::cos(kPi * (row + 0.5) / height);
   }
-  std::vector<float> spreads(solidAngle.size());
-  for (std::size_t c = 0; c < spreads.size(); ++c) spreads[c] = float(solidAngle[c] / std::max(theta[c], phi[c]));
-  return spreads;
+  for (int col = 0; col < width; ++col) {
+    sinPhi[std::size_t(col)] = std::sin(2 * kPi * (col + 0.5) / width);
+    cosPhi[std::size_t(col)] = std::cos(2 * kPi * (col + 0.5) / width);
+  }
+  auto forEachTexel = [&](auto visit) {
+    for (int row = 0; row < height; ++row)
+      for (int col = 0; col < width; ++col) {
+        const double st = sinTheta[std::size_t(row)];
+        visit(std::size_t(row >> log2) * across + (col >> log2), weightOf(row, col), st * cosPhi[std::size_t(col)],
+              st * sinPhi[std::size_t(col)], cosTheta[std::size_t(row)]);
+      }
+  };
+  std::vector<std::array<double, 4>> sum(cells, {0.0, 0.0, 0.0, 0.0});  // Σ w x, Σ w y, Σ w z, Σ w
+  forEachTexel([&](std::size_t c, double w, double x, double y, double z) {
+    sum[c][0] += w * x, sum[c][1] += w * y, sum[c][2] += w * z, sum[c][3] += w;
+  });
+  std::vector<kern::CellFrame> frames(cells, kern::CellFrame{kern::makeVec3(0.0f, 0.0f, 1.0f), 0.0f});
+  std::vector<kern::MaFrame> tangents(cells);  // t and s span the plane tangent to the mean
+  for (std::size_t c = 0; c < cells; ++c) {
+    const double r = std::sqrt(sum[c][0] * sum[c][0] + sum[c][1] * sum[c][1] + sum[c][2] * sum[c][2]);
+    if (!(sum[c][3] > 0 && r > 0)) continue;
+    frames[c].centre = kern::makeVec3(float(sum[c][0] / r), float(sum[c][1] / r), float(sum[c][2] / r));
+    tangents[c] = kern::frameAbout(frames[c].centre);
+  }
+  std::vector<std::array<double, 3>> moment(cells, {0.0, 0.0, 0.0});  // Σ w u², Σ w u v, Σ w v²
+  forEachTexel([&](std::size_t c, double w, double x, double y, double z) {
+    const kern::MaFrame& f = tangents[c];
+    const double u = f.t.x * x + f.t.y * y + f.t.z * z, v = f.s.x * x + f.s.y * y + f.s.z * z;
+    moment[c][0] += w * u * u, moment[c][1] += w * u * v, moment[c][2] += w * v * v;
+  });
+  const double texelExtent = (kPi / height) * (kPi / height) / 12;
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (!(sum[c][3] > 0)) continue;
+    const double uu = moment[c][0] / sum[c][3], uv = moment[c][1] / sum[c][3], vv = moment[c][2] / sum[c][3];
+    const double wider = 0.5 * (uu + vv) + std::sqrt(0.25 * (uu - vv) * (uu - vv) + uv * uv);
+    frames[c].spread = float(1 / (wider + texelExtent));
+  }
+  return frames;
 }
 
 }  // namespace
@@ -422,25 +449,32 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
       solidAngle[cell] += sinTheta * texelArea;
     }
   }
-  const std::vector<float> spreads = cellSpreads(width, height, log2, solidAngle);
+  // The cell's own frame, its directions weighed by solid angle, and its light's, its
+  // texels weighed as its alias table draws them (the cell's own where it holds none):
+  // where the BRDF technique's mass and where f's mass lie (kernels/pixel_optimal.h).
+  const std::vector<kern::CellFrame> area =
+      cellFrames(width, height, log2, [&](int row, int) { return sinThetaOfRow(row, height); });
+  std::vector<kern::CellFrame> light =
+      cellFrames(width, height, log2, [&](int row, int col) { return plain.weights[std::size_t(row) * width + col]; });
+  for (std::size_t c = 0; c < light.size(); ++c)
+    if (!(mass[c] > 0)) light[c] = area[c];
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
-  // Cells: the centre of the texels they hold, the plain mass, the solid angle, the spread
-  // (kernels/pixel_optimal.h, CELL_*).
+  // Cells: their frames, plain masses and solid angles (kernels/pixel_optimal.h, CELL_*).
   tables.blockProbs.assign(std::size_t(tables.pixelCells) * MA_CELL_FLOATS, 0.0f);
   for (int cell = 0; cell < tables.pixelCells; ++cell) {
-    const int col0 = (cell % across) * side, row0 = (cell / across) * side;
-    const float u = float((col0 + 0.5 * std::min(side, width - col0)) / width);
-    const float v = float((row0 + 0.5 * std::min(side, height - row0)) / height);
-    const kern::MaVec3 centre = kern::latLongDirection(u, v);
     auto field = [&](int f) -> float& { return tables.blockProbs[std::size_t(f) * tables.pixelCells + cell]; };
-    field(kern::CELL_X) = centre.x;
-    field(kern::CELL_Y) = centre.y;
-    field(kern::CELL_Z) = centre.z;
+    auto store = [&](int first, const kern::CellFrame& frame) {
+      field(first) = frame.centre.x;
+      field(first + 1) = frame.centre.y;
+      field(first + 2) = frame.centre.z;
+      field(first + 3) = frame.spread;
+    };
+    store(kern::CELL_X, area[std::size_t(cell)]);
+    store(kern::CELL_LIGHT_X, light[std::size_t(cell)]);
     field(kern::CELL_PLAIN) = float(mass[std::size_t(cell)] / plain.total);
     field(kern::CELL_SOLID_ANGLE) = float(solidAngle[std::size_t(cell)]);
-    field(kern::CELL_SPREAD) = spreads[std::size_t(cell)];
   }
   tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
