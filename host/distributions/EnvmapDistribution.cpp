@@ -361,7 +361,7 @@ int pixelCellLog2(int width, int height, int cellsAcross) {
 namespace {
 
 // Per cell of 2^log2 texels a side, its frame (kernels/pixel_optimal.h, CellFrame) under
-// the texels' weights `weightOf(row, col)`: the weighed mean of their directions, and
+// the texels' weights `weightOf(row, col, sin θ)`: the weighed mean of their directions, and
 // the exponent κ = 1/σ² of a cos^κ lobe as wide as they are along their wider axis (σ²
 // the larger eigenvalue of their weighed second moment in the plane tangent to the
 // mean), a texel's own extent (its θ-side²/12) added. A cell whose texels all weigh 0
@@ -384,8 +384,8 @@ std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightO
     for (int row = 0; row < height; ++row)
       for (int col = 0; col < width; ++col) {
         const double st = sinTheta[std::size_t(row)];
-        visit(std::size_t(row >> log2) * across + (col >> log2), weightOf(row, col), st * cosPhi[std::size_t(col)],
-              st * sinPhi[std::size_t(col)], cosTheta[std::size_t(row)]);
+        visit(std::size_t(row >> log2) * across + (col >> log2), weightOf(row, col, st),
+              st * cosPhi[std::size_t(col)], st * sinPhi[std::size_t(col)], cosTheta[std::size_t(row)]);
       }
   };
   std::vector<std::array<double, 4>> sum(cells, {0.0, 0.0, 0.0, 0.0});  // Σ w x, Σ w y, Σ w z, Σ w
@@ -453,9 +453,9 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
   // texels weighed as its alias table draws them (the cell's own where it holds none):
   // where the BRDF technique's mass and where f's mass lie (kernels/pixel_optimal.h).
   const std::vector<kern::CellFrame> area =
-      cellFrames(width, height, log2, [&](int row, int) { return sinThetaOfRow(row, height); });
-  std::vector<kern::CellFrame> light =
-      cellFrames(width, height, log2, [&](int row, int col) { return plain.weights[std::size_t(row) * width + col]; });
+      cellFrames(width, height, log2, [](int, int, double sinTheta) { return sinTheta; });
+  std::vector<kern::CellFrame> light = cellFrames(
+      width, height, log2, [&](int row, int col, double) { return plain.weights[std::size_t(row) * width + col]; });
   for (std::size_t c = 0; c < light.size(); ++c)
     if (!(mass[c] > 0)) light[c] = area[c];
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
