@@ -44,7 +44,9 @@
 // in it lies; and its light's, its texels weighed as its alias table draws them, where
 // f's mass lies (a sun in a cell's corner is there, not at the cell's centre), the
 // cell's own where it holds no light. Then its share of the plain pdf's mass and its
-// solid angle. Each float of every cell in turn (field f of cell c at
+// solid angle; and its peak (host: cellPeaks), the texels over twice its mean light per
+// solid angle, as their share ℓ of its light and ℓ − a, a their share of its solid
+// angle (eq6Value). Each float of every cell in turn (field f of cell c at
 // cells[f · count + c]), so that a pass over cells side by side reads each float side
 // by side.
 enum {
@@ -57,9 +59,11 @@ enum {
   CELL_LIGHT_Z,
   CELL_LIGHT_SPREAD,
   CELL_PLAIN,
-  CELL_SOLID_ANGLE
+  CELL_SOLID_ANGLE,
+  CELL_PEAK_LIGHT,
+  CELL_PEAK_GAP
 };
-#define MA_CELL_FLOATS 10
+#define MA_CELL_FLOATS 12
 // The plain pdf's share of the pixel's table: the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
@@ -76,14 +80,20 @@ enum {
 enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
 #define MA_CHUNK_ROW(count, sum, j) (3 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
 // Then, for the share columns, 1/F and per share its table's (1−C)/B, optimal and plain
-// scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows.
+// scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows. Each share's three lie
+// together, so that no two shares' scales of a kind are adjacent words: the search's
+// shares, computed alike from adjacent words, would be paired into short vectors
+// (docs/pocl.md, rule 8).
 enum {
   SHARE_INV_F,
   SHARE_BRDF_SCALE,
-  SHARE_OPTIMAL = SHARE_BRDF_SCALE + MA_MAX_BANK_SHARES,
-  SHARE_PLAIN = SHARE_OPTIMAL + MA_MAX_BANK_SHARES,
-  SHARE_ROWS = SHARE_PLAIN + MA_MAX_BANK_SHARES
+  SHARE_OPTIMAL,
+  SHARE_PLAIN,
+  SHARE_FIELDS = SHARE_PLAIN,
+  SHARE_ROWS = 1 + SHARE_FIELDS * MA_MAX_BANK_SHARES
 };
+// Share s's field (SHARE_BRDF_SCALE, SHARE_OPTIMAL or SHARE_PLAIN).
+#define MA_SHARE_FIELD(s, field) (SHARE_FIELDS * (s) + (field))
 #define MA_SHARE_ROW(count, q) (MA_CHUNK_ROW(count, CHUNK_SUMS, 0) + (q))
 // Then the product technique's CDF, count + 1 entries.
 #define MA_PRODUCT_CDF_ROW(count, c) (MA_SHARE_ROW(count, SHARE_ROWS) + (c))
@@ -230,14 +240,25 @@ MA_FN PixelOptimalTerms pixelOptimalTerms(MA_LOCAL const int* rows, int stride, 
   return t;
 }
 
-// [Kar19] eq. 6 before normalisation, for a cell's f and p_ρ masses.
-MA_FN float eq6Value(float f, float q, PixelOptimalTerms t) {
-  float v = f * t.invF - t.brdfScale * q;
+// [Kar19] eq. 6 before normalisation, over a cell of f and p_ρ masses. Eq. 6 is
+// pointwise, and max(0, f/F − (1−C) p_ρ/B) of the cell's masses clips a sun with the
+// sky around it where BRDF sampling covers the sky. With f spread as the cell's light
+// and p_ρ evenly, the cell's integral of eq. 6 is convex in (1−C)/B, and the whole
+// cell's term and its peak's, ℓ f/F − a (1−C) p_ρ/B, are two of its tangents: the
+// larger is the closer bound from below. The peak's is written from the whole's, ℓ ·
+// whole + (ℓ − a) · b: two like products here, in the search's three shares unrolled,
+// would be paired into short vectors (docs/pocl.md, rule 8), and so would a max().
+MA_FN float eq6Value(float f, float q, float peakLight, float peakGap, PixelOptimalTerms t) {
+  float b = t.brdfScale * q, whole = f * t.invF - b;
+  float peak = ma_fma(peakGap, b, peakLight * whole);
+  float v = whole > peak ? whole : peak;
   return v > 0.0f ? v : 0.0f;
 }
 
-MA_FN float eq6Term(MA_LOCAL const int* rows, int stride, int count, int c, PixelOptimalTerms t) {
-  return eq6Value(rowFloat(rows, stride, MA_F_ROW(count, c)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
+MA_FN float eq6Term(MA_GLOBAL const float* cells, MA_LOCAL const int* rows, int stride, int count, int c,
+                    PixelOptimalTerms t) {
+  return eq6Value(rowFloat(rows, stride, MA_F_ROW(count, c)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)),
+                  cellField(cells, count, c, CELL_PEAK_LIGHT), cellField(cells, count, c, CELL_PEAK_GAP), t);
 }
 
 // Pass 3: eq. 6's term added to its chunk's sum.
@@ -324,7 +345,7 @@ MA_FN void pixelOptimalPartialSums(MA_GLOBAL const float* cells, int count, Pixe
     MA_CELL_LOOP
     for (int j = 0; j < chunksFrom(count, first); ++j) {
       int c = first + j;
-      partial[j] += cellTableMass(s, eq6Term(rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
+      partial[j] += cellTableMass(s, eq6Term(cells, rows, stride, count, c, t), cellField(cells, count, c, CELL_PLAIN));
       setRowFloat(rows, stride, cellMassRow(count, c, product), partial[j]);
     }
 }
@@ -363,12 +384,12 @@ MA_FN float columnShare(int s) { return (float)(s + 1) / (float)(MA_MAX_BANK_SHA
 // the CDF's first rows, which pass 4 writes later. A sum over the cells in order is one
 // chain of dependent additions, which a lane's own build (samplePixelStage: vectorised
 // over the cells, not across pixels) cannot overlap.
-MA_FN float eq6MassByChunks(int count, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
+MA_FN float eq6MassByChunks(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
   int chunks = count < MA_PIXEL_CHUNKS ? count : MA_PIXEL_CHUNKS;
   for (int j = 0; j < chunks; ++j) setRowFloat(rows, stride, MA_CDF_ROW(j), 0.0f);
   for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
     for (int j = 0; j < chunksFrom(count, first); ++j)
-      addToRowFloat(rows, stride, MA_CDF_ROW(j), eq6Term(rows, stride, count, first + j, t));
+      addToRowFloat(rows, stride, MA_CDF_ROW(j), eq6Term(cells, rows, stride, count, first + j, t));
   float mass = 0.0f;
   for (int j = 0; j < chunks; ++j) mass += rowFloat(rows, stride, MA_CDF_ROW(j));
   return mass;
@@ -376,15 +397,15 @@ MA_FN float eq6MassByChunks(int count, PixelOptimalTerms t, MA_LOCAL int* rows, 
 
 // Pass 3b, for the share columns, while the rows hold each cell's f: 1/F, and per share
 // its (1−C)/B and its table's scales. Only the search reads them.
-MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
+MA_FN void pixelOptimalShareScales(MA_GLOBAL const float* cells, int count, MA_LOCAL int* rows, int stride) {
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, columnShare(s));
-    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(count, t, rows, stride), plain);
+    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(cells, count, t, rows, stride), plain);
     setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F), t.invF);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s), t.brdfScale);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_OPTIMAL + s), scales.optimal);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_PLAIN + s), scales.plain);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_BRDF_SCALE)), t.brdfScale);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)), scales.optimal);
+    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_PLAIN)), scales.plain);
   }
 }
 
@@ -392,7 +413,7 @@ MA_FN void pixelOptimalShareScales(int count, MA_LOCAL int* rows, int stride) {
 MA_FN PixelOptimalTerms shareTerms(MA_LOCAL const int* rows, int stride, int count, int s) {
   PixelOptimalTerms t;
   t.invF = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F));
-  t.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_BRDF_SCALE + s));
+  t.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_BRDF_SCALE)));
   t.lit = 1;
   return t;
 }
@@ -427,8 +448,8 @@ MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongPa
   for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
     MA_CELL_LOOP
     for (int j = 0; j < chunksFrom(count, first); ++j)
-      addToChunkEq6(count, j, eq6Term(rows, stride, count, first + j, t), rows, stride);
-  if (shareColumns) pixelOptimalShareScales(count, rows, stride);
+      addToChunkEq6(count, j, eq6Term(cells, rows, stride, count, first + j, t), rows, stride);
+  if (shareColumns) pixelOptimalShareScales(cells, count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t);
   if (productCdf) {
     ProductCdfTerms p = productCdfTerms(rows, stride, count);
@@ -453,13 +474,15 @@ MA_FN void pixelSharePdfs(EnvmapView env, PhongParams b, MaVec3 normal, MaVec3 m
   PixelCell cell = pixelCellAt(env.blockProbs, count, c);
   float f = cellIntegrand(cell, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
   float plain = cell.plain, inCell = env.texels[4 * t + 3];
+  float peakLight = cellField(env.blockProbs, count, c, CELL_PEAK_LIGHT);
+  float peakGap = cellField(env.blockProbs, count, c, CELL_PEAK_GAP);
   MA_UNROLL
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms terms = shareTerms(rows, stride, count, s);
     PixelTableScales scales;
-    scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_OPTIMAL + s));
-    scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_PLAIN + s));
-    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, eq6Value(f, q, terms), plain), sinTheta);
+    scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)));
+    scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_PLAIN)));
+    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, eq6Value(f, q, peakLight, peakGap, terms), plain), sinTheta);
   }
 }
 

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
@@ -806,6 +807,60 @@ TEST_CASE("the optimal pdf per pixel takes f's mass at a cell's light and p_ρ's
   CHECK(masses.f == kern::cellIntegrand(cell, brdf, patch, patch));
   CHECK((masses.f / f >= 0.5 && masses.f / f <= 2.0));
   CHECK((masses.q / q >= 0.25 && masses.q / q <= 4.0));
+}
+
+TEST_CASE("the optimal pdf per pixel clips a cell by p_ρ's mass where its light lies, not over the whole cell",
+          "[envmap][optimal]") {
+  // Eq. 6 is a pointwise max(0, f/F − (1−C) p_ρ/B); a cell's term is its integral. A dim
+  // cell (0.1 of a map of 1) holds a patch of 2 × 2 texels 20 times the map; a diffuse
+  // BRDF faces it, C = 1/2. Pointwise, the patch stays (20 > 1/2) and the rest of the
+  // cell is clipped (0.1 < 1/2). Over the whole cell, p_ρ's mass outweighs f's and the
+  // cell would be clipped to 0; its peak (buildPixelOptimalEnvmapTables: the texels over
+  // twice its mean light per solid angle) keeps it, against the sum over its texels
+  // within 10 %.
+  const int width = 256, height = 128, row0 = 54, col0 = 86;
+  auto inCell = [&](int col, int row) { return row >> 4 == row0 >> 4 && col >> 4 == col0 >> 4; };
+  auto radiance = [&](int col, int row) {
+    if ((row == row0 || row == row0 + 1) && (col == col0 || col == col0 + 1)) return 20.0f;
+    return inCell(col, row) ? 0.1f : 1.0f;
+  };
+  const Envmap map = greyMap(width, height, radiance);
+  EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map, 16);
+  REQUIRE(tables.blockLog2 == 4);
+  const int cellIndex = (row0 >> 4) * (width >> 4) + (col0 >> 4);
+  const kern::PhongParams diffuse = {1.0f, 0.0f, 1.0f};
+  const kern::MaVec3 normal = kern::latLongDirection(float(col0 + 1) / width, float(row0 + 1) / height);
+  const float C = 0.5f;
+  // Every texel's f and p_ρ mass, f in the cells' units (plain shares times ρ cos).
+  const double texelArea = (2 * kPi / width) * (kPi / height);
+  double plainTotal = 0;
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col) plainTotal += radiance(col, row) * std::sin(kPi * (row + 0.5) / height);
+  std::vector<std::array<double, 3>> texels;  // f, p_ρ, in the cell (1) or not (0)
+  double F = 0, B = 0;
+  for (int row = 0; row < height; ++row)
+    for (int col = 0; col < width; ++col) {
+      const double sinTheta = std::sin(kPi * (row + 0.5) / height);
+      const kern::MaVec3 w = kern::latLongDirection(float((col + 0.5) / width), float((row + 0.5) / height));
+      const float cosine = std::max(0.0f, kern::dot3(normal, w));
+      const double f = radiance(col, row) * sinTheta / plainTotal * kern::phongBrdf(diffuse, 0.0f) * cosine;
+      const double q = sinTheta * texelArea * kern::brdfPdfOf(diffuse, cosine, 0.0f);
+      texels.push_back({f, q, inCell(col, row) ? 1.0 : 0.0});
+      F += f, B += q;
+    }
+  double pointwise = 0, whole[2] = {0, 0};
+  for (const auto& [f, q, cell] : texels)
+    if (cell > 0) pointwise += std::max(0.0, f / F - (1 - C) * q / B), whole[0] += f / F, whole[1] += (1 - C) * q / B;
+  REQUIRE(whole[0] < whole[1]);  // the whole cell's masses alone would clip it
+  REQUIRE(pointwise > 0);
+  kern::PixelOptimalTerms terms;
+  terms.invF = float(1 / F), terms.brdfScale = float((1 - C) / B), terms.lit = 1;
+  const float peakLight = kern::cellField(tables.blockProbs.data(), tables.pixelCells, cellIndex, kern::CELL_PEAK_LIGHT);
+  const float peakGap = kern::cellField(tables.blockProbs.data(), tables.pixelCells, cellIndex, kern::CELL_PEAK_GAP);
+  const float term = kern::eq6Value(float(whole[0] * F), float(whole[1] / (1 - C) * B), peakLight, peakGap, terms);
+  INFO("the cell's eq. 6 term over its texels': " << term / pointwise << " (peak: light " << peakLight << ", gap "
+                                                   << peakGap << ")");
+  CHECK(std::abs(term / pointwise - 1) <= 0.1);
 }
 
 TEST_CASE("sampleEnvmap returns a direction inside the texel it drew", "[envmap]") {

@@ -416,6 +416,34 @@ std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightO
   return frames;
 }
 
+// A cell's peak (kernels/pixel_optimal.h, eq6Value): its texels whose light per solid
+// angle is over kPeakContrast times the cell's mean, as their share of its light and of
+// its solid angle. Any threshold gives a lower bound of eq. 6's integral over the cell;
+// twice the mean separates a sun or a lamp from the sky around it.
+struct CellPeak {
+  double light = 0, area = 0;
+};
+
+constexpr double kPeakContrast = 2;
+
+std::vector<CellPeak> cellPeaks(const std::vector<double>& weights, int width, int height, int log2,
+                                const std::vector<double>& mass, const std::vector<double>& solidAngle) {
+  const int across = (width + (1 << log2) - 1) >> log2;
+  const double texelArea = (2 * kPi / width) * (kPi / height);
+  std::vector<CellPeak> peaks(mass.size());
+  for (int row = 0; row < height; ++row) {
+    const double area = sinThetaOfRow(row, height) * texelArea;
+    for (int col = 0; col < width; ++col) {
+      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      const double w = weights[std::size_t(row) * width + col];
+      if (w * solidAngle[cell] > kPeakContrast * mass[cell] * area) peaks[cell].light += w, peaks[cell].area += area;
+    }
+  }
+  for (std::size_t c = 0; c < peaks.size(); ++c)
+    if (mass[c] > 0) peaks[c] = {peaks[c].light / mass[c], peaks[c].area / solidAngle[c]};
+  return peaks;
+}
+
 }  // namespace
 
 EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross) {
@@ -458,6 +486,7 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
       width, height, log2, [&](int row, int col, double) { return plain.weights[std::size_t(row) * width + col]; });
   for (std::size_t c = 0; c < light.size(); ++c)
     if (!(mass[c] > 0)) light[c] = area[c];
+  const std::vector<CellPeak> peaks = cellPeaks(plain.weights, width, height, log2, mass, solidAngle);
   tables.texels = texelsWithinBlocks(image, plain.weights, mass, log2);
   tables.aliasTable.assign(2 * std::size_t(tables.pixelCells) * side * side, 0u);
   writeBlockSlotTables(plain.weights, width, height, log2, tables.aliasTable.data());
@@ -475,6 +504,9 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
     store(kern::CELL_LIGHT_X, light[std::size_t(cell)]);
     field(kern::CELL_PLAIN) = float(mass[std::size_t(cell)] / plain.total);
     field(kern::CELL_SOLID_ANGLE) = float(solidAngle[std::size_t(cell)]);
+    const CellPeak& peak = peaks[std::size_t(cell)];
+    field(kern::CELL_PEAK_LIGHT) = float(peak.light);
+    field(kern::CELL_PEAK_GAP) = float(peak.light - peak.area);
   }
   tables.cdfTable = {0};
   tables.bankBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
