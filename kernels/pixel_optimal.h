@@ -243,9 +243,9 @@ MA_FN PixelOptimalTerms pixelOptimalTerms(MA_LOCAL const int* rows, int stride, 
 // [Kar19] eq. 6 before normalisation, over a cell of f and p_ρ masses. Eq. 6 is
 // pointwise, and max(0, f/F − (1−C) p_ρ/B) of the cell's masses clips a sun with the
 // sky around it where BRDF sampling covers the sky. With f spread as the cell's light
-// and p_ρ evenly, the cell's integral of eq. 6 is convex in (1−C)/B, and the whole
-// cell's term and its peak's, ℓ f/F − a (1−C) p_ρ/B, are two of its tangents: the
-// larger is the closer bound from below. The peak's is written from the whole's, ℓ ·
+// and p_ρ evenly, f/F − (1−C) p_ρ/B over any set of the cell's texels bounds the cell's
+// integral of eq. 6 from below: over the whole cell, and over its peak, ℓ f/F − a (1−C)
+// p_ρ/B. The larger is the closer. The peak's is written from the whole's, ℓ ·
 // whole + (ℓ − a) · b: two like products here, in the search's three shares unrolled,
 // would be paired into short vectors (docs/pocl.md, rule 8), and so would a max().
 MA_FN float eq6Value(float f, float q, float peakLight, float peakGap, PixelOptimalTerms t) {
