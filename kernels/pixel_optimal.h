@@ -255,10 +255,15 @@ MA_FN float eq6Value(float f, float q, float peakLight, float peakGap, PixelOpti
   return v > 0.0f ? v : 0.0f;
 }
 
+// Cell c's eq. 6 term, given its f and p_ρ masses.
+MA_FN float cellEq6(MA_GLOBAL const float* cells, int count, int c, float f, float q, PixelOptimalTerms t) {
+  return eq6Value(f, q, cellField(cells, count, c, CELL_PEAK_LIGHT), cellField(cells, count, c, CELL_PEAK_GAP), t);
+}
+
 MA_FN float eq6Term(MA_GLOBAL const float* cells, MA_LOCAL const int* rows, int stride, int count, int c,
                     PixelOptimalTerms t) {
-  return eq6Value(rowFloat(rows, stride, MA_F_ROW(count, c)), rowFloat(rows, stride, MA_BRDF_ROW(count, c)),
-                  cellField(cells, count, c, CELL_PEAK_LIGHT), cellField(cells, count, c, CELL_PEAK_GAP), t);
+  return cellEq6(cells, count, c, rowFloat(rows, stride, MA_F_ROW(count, c)),
+                 rowFloat(rows, stride, MA_BRDF_ROW(count, c)), t);
 }
 
 // Pass 3: eq. 6's term added to its chunk's sum.
@@ -474,15 +479,13 @@ MA_FN void pixelSharePdfs(EnvmapView env, PhongParams b, MaVec3 normal, MaVec3 m
   PixelCell cell = pixelCellAt(env.blockProbs, count, c);
   float f = cellIntegrand(cell, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
   float plain = cell.plain, inCell = env.texels[4 * t + 3];
-  float peakLight = cellField(env.blockProbs, count, c, CELL_PEAK_LIGHT);
-  float peakGap = cellField(env.blockProbs, count, c, CELL_PEAK_GAP);
   MA_UNROLL
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms terms = shareTerms(rows, stride, count, s);
     PixelTableScales scales;
     scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)));
     scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_PLAIN)));
-    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, eq6Value(f, q, peakLight, peakGap, terms), plain), sinTheta);
+    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, cellEq6(env.blockProbs, count, c, f, q, terms), plain), sinTheta);
   }
 }
 

@@ -21,6 +21,16 @@ namespace {
 
 double sinThetaOfRow(int row, int height) { return std::sin(kPi * (row + 0.5) / height); }
 
+// A texel's solid angle in a row of a W × H lat-long map: sin θ dφ dθ.
+double texelSolidAngle(int row, int width, int height) {
+  return sinThetaOfRow(row, height) * ((2 * kPi / width) * (kPi / height));
+}
+
+// The cell of 2^log2 × 2^log2 texels, `across` of them a row, that holds texel (row, col).
+std::size_t cellOfTexel(int row, int col, int log2, int across) {
+  return std::size_t(row >> log2) * std::size_t(across) + std::size_t(col >> log2);
+}
+
 void requireValidSize(const Envmap& envmap) {
   const RgbImage& image = envmap.image;
   // kernels/envmap.h indexes the texels' floats as int 4·t.
@@ -384,7 +394,7 @@ std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightO
     for (int row = 0; row < height; ++row)
       for (int col = 0; col < width; ++col) {
         const double st = sinTheta[std::size_t(row)];
-        visit(std::size_t(row >> log2) * across + (col >> log2), weightOf(row, col, st),
+        visit(cellOfTexel(row, col, log2, across), weightOf(row, col, st),
               st * cosPhi[std::size_t(col)], st * sinPhi[std::size_t(col)], cosTheta[std::size_t(row)]);
       }
   };
@@ -429,12 +439,11 @@ constexpr double kPeakContrast = 2;
 std::vector<CellPeak> cellPeaks(const std::vector<double>& weights, int width, int height, int log2,
                                 const std::vector<double>& mass, const std::vector<double>& solidAngle) {
   const int across = (width + (1 << log2) - 1) >> log2;
-  const double texelArea = (2 * kPi / width) * (kPi / height);
   std::vector<CellPeak> peaks(mass.size());
   for (int row = 0; row < height; ++row) {
-    const double area = sinThetaOfRow(row, height) * texelArea;
+    const double area = texelSolidAngle(row, width, height);
     for (int col = 0; col < width; ++col) {
-      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      const std::size_t cell = cellOfTexel(row, col, log2, across);
       const double w = weights[std::size_t(row) * width + col];
       if (w * solidAngle[cell] > kPeakContrast * mass[cell] * area) peaks[cell].light += w, peaks[cell].area += area;
     }
@@ -468,13 +477,12 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
 
   // Per cell: the plain mass and the solid angle, each a sum over its texels.
   std::vector<double> mass(std::size_t(tables.pixelCells), 0.0), solidAngle(mass.size(), 0.0);
-  const double texelArea = (2 * kPi / width) * (kPi / height);  // dω = sin θ dφ dθ
   for (int row = 0; row < height; ++row) {
-    const double sinTheta = sinThetaOfRow(row, height);
+    const double area = texelSolidAngle(row, width, height);
     for (int col = 0; col < width; ++col) {
-      const std::size_t cell = std::size_t(row >> log2) * across + (col >> log2);
+      const std::size_t cell = cellOfTexel(row, col, log2, across);
       mass[cell] += plain.weights[std::size_t(row) * width + col];
-      solidAngle[cell] += sinTheta * texelArea;
+      solidAngle[cell] += area;
     }
   }
   // The cell's own frame, its directions weighed by solid angle, and its light's, its
