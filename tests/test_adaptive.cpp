@@ -43,11 +43,12 @@ TEST_CASE("stage sizes follow the pilot share and sum to the budget", "[adaptive
   CHECK(stageSizes(0.2, 4, 200, 2) == std::vector<int>{40, 40, 40, 40, 40});
   CHECK(stageSizes(0.2, 4, 103, 2) == std::vector<int>{21, 21, 21, 20, 20});
   CHECK(stageSizes(0.1, 2, 20, 3) == std::vector<int>{6, 7, 7});  // at least 2 per technique
-  // The pilot fills passes of kPilotLanes per technique within a quarter of the budget.
-  CHECK(stageSizes(0.05, 1, 200, 2) == std::vector<int>{32, 168});
-  CHECK(stageSizes(0.05, 1, 200, 3) == std::vector<int>{48, 152});
-  CHECK(stageSizes(0.05, 2, 800, 2) == std::vector<int>{64, 368, 368});
-  CHECK(stageSizes(0.05, 1, 100, 2) == std::vector<int>{5, 95});  // 32 > 100/4
+  // The pilot takes kPilotSamplesPerTechnique per technique within an eighth of the budget.
+  CHECK(stageSizes(0.05, 1, 200, 2) == std::vector<int>{16, 184});
+  CHECK(stageSizes(0.05, 1, 200, 3) == std::vector<int>{24, 176});
+  CHECK(stageSizes(0.05, 2, 800, 2) == std::vector<int>{40, 380, 380});  // 5 % is above the floor
+  CHECK(stageSizes(0.05, 1, 128, 2) == std::vector<int>{16, 112});
+  CHECK(stageSizes(0.05, 1, 100, 2) == std::vector<int>{5, 95});  // 16 > 100/8
   CHECK_THROWS_AS(stageSizes(0.2, 4, 6, 2), InputError);          // no room after the pilot
   CHECK_THROWS_AS(stageSizes(0.0, 4, 200, 2), InputError);
   CHECK_THROWS_AS(stageSizes(0.2, 0, 200, 2), InputError);

@@ -30,8 +30,8 @@ void AdaptiveArgs::add(CLI::App& command) {
   command
       .add_option(
           "--pilot", options.pilotFraction,
-          "adaptive methods: the pilot's share of the budget, raised to fill whole passes of 16 samples per technique "
-          "where that stays within a quarter of it")
+          "adaptive methods: the pilot's share of the budget, raised to 8 samples per technique where that stays "
+          "within an eighth of it")
       ->capture_default_str()
       ->check(realIn(0, 1, true, true));
   command.add_option("--stages", options.stages, "adaptive methods: stages after the pilot")

@@ -53,8 +53,8 @@ void accumulateStage(StageTotals& totals, const TakenStage& stage, Estimator est
 
 int pilotSamples(double pilotFraction, int spp, int techniqueCount) {
   const int pilot = std::max(2 * techniqueCount, int(std::lround(pilotFraction * spp)));
-  const int pass = techniqueCount * kPilotLanes, filled = (pilot + pass - 1) / pass * pass;
-  return filled <= spp / 4 ? filled : pilot;
+  const int floor = kPilotSamplesPerTechnique * techniqueCount;
+  return pilot < floor && 8 * floor <= spp ? floor : pilot;
 }
 
 std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount) {

@@ -49,16 +49,16 @@ struct AdaptiveOptions {
   MisWeights weights = MisWeights::Balance;
 };
 
-// The pilot's samples fill whole passes of this many lanes per technique where that
-// keeps the pilot within a quarter of the budget (pilotSamples): on a CPU a pass of
-// samplePixelStage costs the same however many of its lanes hold a sample
-// (kernels/sample.cl), and a 200-spp pilot's 5 per technique left 11 of 16 lanes idle.
-// 16, AVX-512's float width and twice AVX2's, on every device: every device then
-// renders the same image (docs/results.md, "The pilot in samplePixelStage").
-inline constexpr int kPilotLanes = 16;
+// The pilot's floor per technique, where it costs at most an eighth of the budget
+// (pilotSamples). The grid search ranks α from the pilot's samples pooled over a
+// window; 5 per technique (a 5 % pilot at 200 spp) misjudged small suns, 8 did not. A
+// larger pilot costs image quality: its samples come from the coarser pilot table
+// (Scene::pilotTables), and the search reads every one (docs/results.md, "A smaller
+// pilot").
+inline constexpr int kPilotSamplesPerTechnique = 8;
 
-// The pilot's samples: f·N, at least two per technique, raised to whole passes of
-// kPilotLanes per technique where that is at most N/4.
+// The pilot's samples: f·N, at least two per technique, raised to
+// kPilotSamplesPerTechnique per technique where that is at most N/8.
 int pilotSamples(double pilotFraction, int spp, int techniqueCount);
 
 // The sizes of the pilot and the following stages, summing to spp. Throws InputError
