@@ -8,8 +8,11 @@
 // cosine averaged over the frame's spread (cellLobe, cellCosine), and the cells weighed
 // by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its bound s = 1/C, which the optimal pdf's bank measures within
 // a few percent of eq. 9's variance (render.json, one_sample_variance_eq6_over_eq9_mean).
-// A share of the plain pdf keeps every lit cell drawable (the cells' means are
-// estimates: a cell weighed 0 may hold lit texels above the horizon). The pixel's CDF
+// Where the stage draws no BRDF samples (C = 1: the product technique's table, or a
+// stage that gives the BRDF none), a share of the plain pdf keeps every lit cell
+// drawable (the cells' means are estimates: a cell weighed 0 may hold lit texels above
+// the horizon). Elsewhere BRDF sampling covers every direction where f ≠ 0, and the
+// table is eq. 6's alone. The pixel's CDF
 // over the cells lives in its rows of local memory (kernels/pixel_layout.h); a texel
 // within the drawn cell comes from the cell's alias table ∝ luminance × sin θ, as for
 // the bank (kernels/envmap.h, sampleEnvmapPixelCells). The pdf a sample is weighed with
@@ -64,7 +67,8 @@ enum {
   CELL_PEAK_GAP
 };
 #define MA_CELL_FLOATS 12
-// The plain pdf's share of the pixel's table: the defensive part.
+// The plain pdf's share of the pixel's table where no BRDF sample covers what eq. 6
+// leaves out (tableScalesOf): the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
@@ -277,9 +281,14 @@ typedef struct {
   float optimal, plain;
 } PixelTableScales;
 
-// The scales, given eq. 6's mass and the plain mass over all cells.
+// The scales, given eq. 6's mass and the plain mass over all cells. d is 0 where the
+// stage draws BRDF samples ((1−C)/B > 0): they cover what eq. 6 clips, and a plain
+// share there only adds variance where the table is already close to f, 1.2× the
+// error of `equal` at equal samples (docs/results.md, "No plain share beside BRDF
+// sampling"). Where C = 1, d = MA_PIXEL_PLAIN_SHARE.
 MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plain) {
-  float optimalShare = t.lit && mass > 0.0f ? 1.0f - MA_PIXEL_PLAIN_SHARE : 0.0f;
+  float defensive = t.brdfScale > 0.0f ? 0.0f : MA_PIXEL_PLAIN_SHARE;
+  float optimalShare = t.lit && mass > 0.0f ? 1.0f - defensive : 0.0f;
   PixelTableScales s;
   s.optimal = optimalShare > 0.0f ? optimalShare / mass : 0.0f;
   s.plain = plain > 0.0f ? (1.0f - optimalShare) / plain : 0.0f;

@@ -512,7 +512,8 @@ std::vector<double> pixelTexelProbabilities(const kern::EnvmapView& view, bool p
 }
 
 TEST_CASE(
-    "the optimal pdf per pixel draws texels with the probabilities it evaluates, positive wherever the map is lit",
+    "the optimal pdf per pixel draws texels with the probabilities it evaluates, positive wherever the map is lit "
+    "and no BRDF sample covers it",
     "[envmap][optimal][product]") {
   // kernels/pixel_optimal.h: a cell by the pixel's own CDF, built from its normal, mirror
   // direction, BRDF and envmap share, then a texel of the cell by the plain weights, at
@@ -521,6 +522,7 @@ TEST_CASE(
   // alarm in any χ² test with probability 2 %.
   const std::vector<PixelOptimalPoint> points = pixelOptimalPoints();
   const double level = misalloc::test::sidakLevel(0.02, int(2 * std::size(points) * testMaps().size()));
+  std::size_t clippedLit = 0;  // lit texels that a table of C < 1 leaves to BRDF sampling
   for (const auto& [name, map] : testMaps()) {
     EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(map);
     INFO(name);
@@ -543,11 +545,17 @@ TEST_CASE(
       for (bool isProduct : {false, true}) {
         INFO((isProduct ? "the product's table" : "the envmap's table"));
         const std::vector<double> p = pixelTexelProbabilities(isProduct ? both : view, isProduct);
+        // Where the stage draws BRDF samples (C < 1) the envmap's table is eq. 6's alone: a
+        // lit texel may be left out only with its cell, which eq. 6 clips and BRDF sampling
+        // covers. At C = 1, and in the product's table, the plain share keeps it drawable.
+        const bool brdfCovers = !isProduct && point.share < 1.0f;
         double sum = 0;
         std::size_t unlit = 0;
         for (std::size_t t = 0; t < p.size(); ++t) {
           sum += p[t];
-          unlit += plain[t] > 0 && !(p[t] > 0);
+          const bool clipped = brdfCovers && kern::pixelCellProbability(view, kern::blockOfTexel(view, int(t))) == 0;
+          unlit += plain[t] > 0 && !(p[t] > 0) && !clipped;
+          clippedLit += plain[t] > 0 && clipped;
         }
         // A cell's and a texel's probability, each rounded to float, and their product.
         CHECK(std::abs(sum - 1) <= 8 * kFloatRounding + double(p.size()) * kDoubleRounding);
@@ -571,6 +579,7 @@ TEST_CASE(
       CHECK(worst <= 8 / kGrid24);
     }
   }
+  CHECK(clippedLit > 0);  // no plain share beside BRDF sampling
 }
 
 TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables built for their shares",
