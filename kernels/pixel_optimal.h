@@ -282,10 +282,9 @@ typedef struct {
 } PixelTableScales;
 
 // The scales, given eq. 6's mass and the plain mass over all cells. d is 0 where the
-// stage draws BRDF samples ((1−C)/B > 0): they cover what eq. 6 clips, and a plain
-// share there only adds variance where the table is already close to f, 1.2× the
-// error of `equal` at equal samples (docs/results.md, "No plain share beside BRDF
-// sampling"). Where C = 1, d = MA_PIXEL_PLAIN_SHARE.
+// stage draws BRDF samples ((1−C)/B > 0), which cover what eq. 6 clips ([Kar19] Sec.
+// 4): a plain share there only adds variance (docs/results.md, "No plain share beside
+// BRDF sampling").
 MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plain) {
   float defensive = t.brdfScale > 0.0f ? 0.0f : MA_PIXEL_PLAIN_SHARE;
   float optimalShare = t.lit && mass > 0.0f ? 1.0f - defensive : 0.0f;
