@@ -40,18 +40,30 @@ MeanAndError imageMean(const RgbImage& image) {
 }  // namespace
 
 TEST_CASE("stage sizes follow the pilot share and sum to the budget", "[adaptive]") {
-  CHECK(stageSizes(0.2, 4, 200, 2) == std::vector<int>{40, 40, 40, 40, 40});
-  CHECK(stageSizes(0.2, 4, 103, 2) == std::vector<int>{21, 21, 21, 20, 20});
-  CHECK(stageSizes(0.1, 2, 20, 3) == std::vector<int>{6, 7, 7});  // at least 2 per technique
-  // The pilot takes kPilotSamplesPerTechnique per technique within an eighth of the budget.
-  CHECK(stageSizes(0.05, 1, 200, 2) == std::vector<int>{16, 184});
-  CHECK(stageSizes(0.05, 1, 200, 3) == std::vector<int>{24, 176});
-  CHECK(stageSizes(0.05, 2, 800, 2) == std::vector<int>{40, 380, 380});  // 5 % is above the floor
-  CHECK(stageSizes(0.05, 1, 128, 2) == std::vector<int>{16, 112});
-  CHECK(stageSizes(0.05, 1, 100, 2) == std::vector<int>{5, 95});  // 16 > 100/8
-  CHECK_THROWS_AS(stageSizes(0.2, 4, 6, 2), InputError);          // no room after the pilot
-  CHECK_THROWS_AS(stageSizes(0.0, 4, 200, 2), InputError);
-  CHECK_THROWS_AS(stageSizes(0.2, 0, 200, 2), InputError);
+  for (Method m : {Method::Exact, Method::Heuristic}) {
+    CHECK(stageSizes(0.2, 4, 200, 2, m) == std::vector<int>{40, 40, 40, 40, 40});
+    CHECK(stageSizes(0.2, 4, 103, 2, m) == std::vector<int>{21, 21, 21, 20, 20});
+    CHECK(stageSizes(0.1, 2, 20, 3, m) == std::vector<int>{6, 7, 7});  // at least 2 per technique
+    CHECK(stageSizes(0.05, 1, 100, 2, m) == std::vector<int>{5, 95});  // no floor within N/8 or pass within N/4
+    CHECK_THROWS_AS(stageSizes(0.2, 4, 6, 2, m), InputError);          // no room after the pilot
+    CHECK_THROWS_AS(stageSizes(0.0, 4, 200, 2, m), InputError);
+    CHECK_THROWS_AS(stageSizes(0.2, 0, 200, 2, m), InputError);
+  }
+  // exact's and equal's (--weights optimal) pilots take kPilotSamplesPerTechnique per
+  // technique within an eighth of the budget.
+  for (Method m : {Method::Exact, Method::Equal}) {
+    CHECK(stageSizes(0.05, 1, 200, 2, m) == std::vector<int>{16, 184});
+    CHECK(stageSizes(0.05, 1, 200, 3, m) == std::vector<int>{24, 176});
+    CHECK(stageSizes(0.05, 2, 800, 2, m) == std::vector<int>{40, 380, 380});  // 5 % is above the floor
+    CHECK(stageSizes(0.05, 1, 128, 2, m) == std::vector<int>{16, 112});
+  }
+  // The per-pixel rules' fill passes of kPilotLanes per technique within a quarter of the budget.
+  for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
+    CHECK(stageSizes(0.05, 1, 200, 2, m) == std::vector<int>{32, 168});
+    CHECK(stageSizes(0.05, 1, 200, 3, m) == std::vector<int>{48, 152});
+    CHECK(stageSizes(0.05, 2, 800, 2, m) == std::vector<int>{64, 368, 368});
+    CHECK(stageSizes(0.05, 1, 128, 2, m) == std::vector<int>{32, 96});
+  }
 }
 
 TEST_CASE("adaptive methods spend exactly the budget of every pixel", "[adaptive]") {

@@ -30,8 +30,9 @@ void AdaptiveArgs::add(CLI::App& command) {
   command
       .add_option(
           "--pilot", options.pilotFraction,
-          "adaptive methods: the pilot's share of the budget, raised to 8 samples per technique where that stays "
-          "within an eighth of it")
+          "adaptive methods: the pilot's share of the budget, raised for exact to 8 samples per technique within "
+          "an eighth of it, for heuristic, sigma-sqrt-c and linear to whole passes of 16 per technique within a "
+          "quarter")
       ->capture_default_str()
       ->check(realIn(0, 1, true, true));
   command.add_option("--stages", options.stages, "adaptive methods: stages after the pilot")

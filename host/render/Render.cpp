@@ -51,17 +51,22 @@ void accumulateStage(StageTotals& totals, const TakenStage& stage, Estimator est
 
 }  // namespace
 
-int pilotSamples(double pilotFraction, int spp, int techniqueCount) {
+int pilotSamples(double pilotFraction, int spp, int techniqueCount, Method method) {
   const int pilot = std::max(2 * techniqueCount, int(std::lround(pilotFraction * spp)));
-  const int floor = kPilotSamplesPerTechnique * techniqueCount;
-  return pilot < floor && 8 * floor <= spp ? floor : pilot;
+  const MethodTraits& traits = methodTraits(method);
+  if (!traits.adaptive() || traits.searchesWeights) {
+    const int floor = kPilotSamplesPerTechnique * techniqueCount;
+    return pilot < floor && 8 * floor <= spp ? floor : pilot;
+  }
+  const int pass = kPilotLanes * techniqueCount, filled = (pilot + pass - 1) / pass * pass;
+  return filled <= spp / 4 ? filled : pilot;
 }
 
-std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount) {
+std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount, Method method) {
   if (!(pilotFraction > 0 && pilotFraction < 1))
     throw InputError(fmt::format("--pilot {}: the pilot's share of the budget must lie in (0, 1)", pilotFraction));
   if (stages < 1) throw InputError(fmt::format("--stages {}: need at least one stage after the pilot", stages));
-  const int pilot = pilotSamples(pilotFraction, spp, techniqueCount);
+  const int pilot = pilotSamples(pilotFraction, spp, techniqueCount, method);
   if (spp < pilot + stages)
     throw InputError(
         fmt::format("--spp {} is smaller than the pilot ({} samples: at least 2 per technique) plus {} "
@@ -167,8 +172,8 @@ std::vector<int32_t> equalCounts(int pixels, int M, int stageSamples) {
 
 // The largest stage that keeps statistics (all but the last), of the stages of the
 // scene's technique count M: the grid searches store its samples.
-int largestStatisticsStage(const AdaptiveOptions& options, int spp, int techniqueCount) {
-  std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, techniqueCount);
+int largestStatisticsStage(Method method, const AdaptiveOptions& options, int spp, int techniqueCount) {
+  std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, techniqueCount, method);
   sizes.pop_back();
   return *std::max_element(sizes.begin(), sizes.end());
 }
@@ -191,7 +196,7 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
     // The grid searches keep running sums: the samples of one stage at a time are
     // stored, and the last stage stores none (the oracle's: its probe only).
     config.sampleCapacity =
-        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(options, spp, techniqueCount);
+        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(method, options, spp, techniqueCount);
     config.gridSize = options.gridSize;
     config.runningSums = traits.split == Split::Staged && options.stages > 1;
     // Rule (b) judges each α_0 by the pdf of the share it would run (WeightGrid).
@@ -269,7 +274,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     // A fixed split has nothing to solve the optimal weights from: a pilot of the same
     // split with the balance heuristic, then the rest with the weights solved from it,
     // each stage weighted by its size.
-    std::vector<int> sizes = stageSizes(options.pilotFraction, 1, spp, M);
+    std::vector<int> sizes = stageSizes(options.pilotFraction, 1, spp, M, method);
     out.stageCount = 2;
     TakenStage pilot =
         takeStage(sampler, progress, singleStagePlan(scene, method, sizes[0]).counts, sizes[0], seed, true, nullptr);
@@ -306,7 +311,7 @@ Rendering render(StageSampler& sampler, Method method, const AdaptiveOptions& op
     accumulateStage(render.totals, stage, estimator, std::vector<double>(pixels, 1.0));
     progress = std::move(render);
   } else {
-    std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
+    std::vector<int> sizes = stageSizes(options.pilotFraction, options.stages, spp, M, method);
     out.stageCount = int(sizes.size());
     std::fill(progress.skipped.begin(), progress.skipped.end(), 1);
     TakenStage pilot = takeStage(sampler, progress, equalCounts(pixels, M, sizes[0]), sizes[0], seed, true, model);

@@ -49,21 +49,31 @@ struct AdaptiveOptions {
   MisWeights weights = MisWeights::Balance;
 };
 
-// The pilot's floor per technique, where it costs at most an eighth of the budget
-// (pilotSamples). The grid search ranks α from the pilot's samples pooled over a
+// The pilot of exact, and of equal with optimal weights, takes at least this many
+// samples per technique, where that costs at most an eighth of the budget
+// (pilotSamples). exact's grid search ranks α from the pilot's samples pooled over a
 // window; 5 per technique (a 5 % pilot at 200 spp) misjudged small suns, 8 did not. A
 // larger pilot costs image quality: its samples come from the coarser pilot table
 // (Scene::pilotTables), and the search reads every one (docs/results.md, "A smaller
 // pilot").
 inline constexpr int kPilotSamplesPerTechnique = 8;
 
-// The pilot's samples: f·N, at least two per technique, raised to
-// kPilotSamplesPerTechnique per technique where that is at most N/8.
-int pilotSamples(double pilotFraction, int spp, int techniqueCount);
+// The pilot of a method whose α is a per-pixel rule over running sums (heuristic,
+// sigma-sqrt-c, linear) fills whole passes of this many lanes per technique where that
+// keeps it within a quarter of the budget (pilotSamples): heuristic's and linear's
+// variance ratios, from 8 samples per technique, misjudged α (docs/results.md, "The
+// pilot's size by method"). On a CPU a pass of samplePixelStage costs the same however
+// many of its 16 lanes hold a sample (kernels/sample.cl).
+inline constexpr int kPilotLanes = 16;
 
-// The sizes of the pilot and the following stages, summing to spp. Throws InputError
-// if the budget cannot hold a pilot of two samples per technique plus one stage.
-std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount);
+// The pilot's samples: f·N, at least two per technique, raised for `method` as the two
+// constants above say.
+int pilotSamples(double pilotFraction, int spp, int techniqueCount, Method method);
+
+// The sizes of `method`'s pilot and the following stages, summing to spp. Throws
+// InputError if the budget cannot hold a pilot of two samples per technique plus one
+// stage.
+std::vector<int> stageSizes(double pilotFraction, int stages, int spp, int techniqueCount, Method method);
 
 // One stage's kernel time, and the cost model's prediction of it, made before it ran.
 struct StageTiming {

@@ -89,7 +89,7 @@ void requireCoveredStages(const SceneOptions& scene, Method method, Estimator es
                     biasReason(scene, estimator)));
   }
   std::vector<int> sizes{spp};
-  if (traits.split == Split::Staged) sizes = stageSizes(options.pilotFraction, options.stages, spp, M);
+  if (traits.split == Split::Staged) sizes = stageSizes(options.pilotFraction, options.stages, spp, M, method);
   const int smallest = *std::min_element(sizes.begin(), sizes.end());
   if (!allocatedStageCovers(scene, smallest, traits.estimator))
     throw InputError(fmt::format(
@@ -125,7 +125,7 @@ void requireOptimalWeightsRun(const SceneOptions& scene, Method method, Estimato
         "variance, which ranks the variance of the optimal weights");
   std::vector<int> sizes{spp};
   if (traits.split != Split::Probed)
-    sizes = stageSizes(options.pilotFraction, traits.adaptive() ? options.stages : 1, spp, M);
+    sizes = stageSizes(options.pilotFraction, traits.adaptive() ? options.stages : 1, spp, M, method);
   const int smallest = *std::min_element(sizes.begin(), sizes.end());
   if (smallest < M)
     throw InputError(
