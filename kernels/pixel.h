@@ -92,6 +92,10 @@ MA_FN float stageEnvmapShare(int product, StageCounts c) {
   return bankEnvmapFraction(product, c.n0, c.n1, (float)c.n0 / (float)c.stageSamples);
 }
 
+// Whether the stage draws BRDF samples (technique 1), which cover every direction where
+// f ≠ 0: the optimal pdf per pixel then needs no plain share (kernels/pixel_optimal.h).
+MA_FN int stageDrawsBrdf(StageCounts c) { return c.n1 > 0; }
+
 // The share column whose table the stage's envmap samples draw with: the bank's entry's,
 // or for the optimal pdf per pixel the share nearest the stage's own C, which its table
 // is built for; 0 where there are no shares.

@@ -8,11 +8,10 @@
 // cosine averaged over the frame's spread (cellLobe, cellCosine), and the cells weighed
 // by eq. 6, max(0, f − (1−C) p_ρ) with both normalised: eq. 9 at its bound s = 1/C, which the optimal pdf's bank measures within
 // a few percent of eq. 9's variance (render.json, one_sample_variance_eq6_over_eq9_mean).
-// Where the stage draws no BRDF samples (C = 1: the product technique's table, or a
-// stage that gives the BRDF none), a share of the plain pdf keeps every lit cell
+// Where the stage draws no BRDF samples, a share of the plain pdf keeps every lit cell
 // drawable (the cells' means are estimates: a cell weighed 0 may hold lit texels above
 // the horizon). Elsewhere BRDF sampling covers every direction where f ≠ 0, and the
-// table is eq. 6's alone. The pixel's CDF
+// table is eq. 6's alone; so is the product technique's. The pixel's CDF
 // over the cells lives in its rows of local memory (kernels/pixel_layout.h); a texel
 // within the drawn cell comes from the cell's alias table ∝ luminance × sin θ, as for
 // the bank (kernels/envmap.h, sampleEnvmapPixelCells). The pdf a sample is weighed with
@@ -31,7 +30,7 @@
 // pdf and the allocation), as it does with the bank's entries.
 //
 // The product technique ([CL18]) from the same cells (--product with this pdf): its table
-// is eq. 6 at C = 1, f/F with the same plain share, where BRDF sampling takes no part. Its
+// is eq. 6 at C = 1, f/F, with the plain share where the stage draws no BRDF samples. Its
 // CDF is written beside the envmap's from the same f, in the same passes: per pixel, with
 // no table binned over BRDFs or geometry (kernels/product.h, ProductView::pixelCells).
 #include "namespace_check.h"
@@ -67,7 +66,7 @@ enum {
   CELL_PEAK_GAP
 };
 #define MA_CELL_FLOATS 12
-// The plain pdf's share of the pixel's table where no BRDF sample covers what eq. 6
+// The plain pdf's share of the pixel's tables where no BRDF sample covers what eq. 6
 // leaves out (tableScalesOf): the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
 
@@ -282,11 +281,11 @@ typedef struct {
 } PixelTableScales;
 
 // The scales, given eq. 6's mass and the plain mass over all cells. d is 0 where the
-// stage draws BRDF samples ((1−C)/B > 0), which cover what eq. 6 clips ([Kar19] Sec.
-// 4): a plain share there only adds variance (docs/results.md, "No plain share beside
-// BRDF sampling").
-MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plain) {
-  float defensive = t.brdfScale > 0.0f ? 0.0f : MA_PIXEL_PLAIN_SHARE;
+// stage draws BRDF samples (brdfCovers), which cover what eq. 6 clips ([Kar19] Sec. 4),
+// and what the product's cells miss: a plain share there only adds variance
+// (docs/results.md, "No plain share beside BRDF sampling").
+MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plain, int brdfCovers) {
+  float defensive = brdfCovers ? 0.0f : MA_PIXEL_PLAIN_SHARE;
   float optimalShare = t.lit && mass > 0.0f ? 1.0f - defensive : 0.0f;
   PixelTableScales s;
   s.optimal = optimalShare > 0.0f ? optimalShare / mass : 0.0f;
@@ -294,8 +293,10 @@ MA_FN PixelTableScales tableScalesOf(PixelOptimalTerms t, float mass, float plai
   return s;
 }
 
-MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
-  return tableScalesOf(t, chunkTotal(rows, stride, count, CHUNK_EQ6), chunkTotal(rows, stride, count, CHUNK_PLAIN));
+MA_FN PixelTableScales pixelTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t,
+                                        int brdfCovers) {
+  return tableScalesOf(t, chunkTotal(rows, stride, count, CHUNK_EQ6), chunkTotal(rows, stride, count, CHUNK_PLAIN),
+                       brdfCovers);
 }
 
 // A cell's mass in the table, from its eq. 6 term and its plain mass.
@@ -318,10 +319,11 @@ MA_FN PixelOptimalTerms productTerms(MA_LOCAL const int* rows, int stride, int c
   return pixelOptimalTerms(rows, stride, count, 1.0f);
 }
 
-MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t) {
+MA_FN PixelTableScales productTableScales(MA_LOCAL const int* rows, int stride, int count, PixelOptimalTerms t,
+                                          int brdfCovers) {
   float mass = 0.0f;
   for (int j = 0; j < MA_PIXEL_CHUNKS; ++j) mass += chunkEq6Mass(rows, stride, count, j, t, 1);
-  return tableScalesOf(t, mass, chunkTotal(rows, stride, count, CHUNK_PLAIN));
+  return tableScalesOf(t, mass, chunkTotal(rows, stride, count, CHUNK_PLAIN), brdfCovers);
 }
 
 // Pass 4, per chunk: its CDF entries ⌈offset + partial sum⌉ on uniformFloat's grid, the
@@ -414,7 +416,8 @@ MA_FN void pixelOptimalShareScales(MA_GLOBAL const float* cells, int count, MA_L
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, columnShare(s));
-    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(cells, count, t, rows, stride), plain);
+    // A stage of share C_s < 1 draws BRDF samples.
+    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(cells, count, t, rows, stride), plain, 1);
     setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F), t.invF);
     setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_BRDF_SCALE)), t.brdfScale);
     setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)), scales.optimal);
@@ -437,19 +440,21 @@ typedef struct {
   PixelTableScales s;
 } ProductCdfTerms;
 
-MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int count) {
+MA_FN ProductCdfTerms productCdfTerms(MA_LOCAL const int* rows, int stride, int count, int brdfCovers) {
   ProductCdfTerms p;
   p.t = productTerms(rows, stride, count);
-  p.s = productTableScales(rows, stride, count, p.t);
+  p.s = productTableScales(rows, stride, count, p.t, brdfCovers);
   return p;
 }
 
 // The whole build by one work-item (the C++ reference): the pixel's CDF over `count`
-// cells at rows[r · stride], r = 0 … count, for a stage of envmap share C; with
-// `shareColumns`, the share columns' scales too; with `productCdf`, the product's CDF.
-// Both kernels call it, one pixel a work-item.
+// cells at rows[r · stride], r = 0 … count, for a stage of envmap share C that draws
+// BRDF samples or not (brdfCovers, stageDrawsBrdf); with `shareColumns`, the share
+// columns' scales too; with `productCdf`, the product's CDF. Both kernels call it, one
+// pixel a work-item.
 MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongParams b, MaVec3 normal, MaVec3 mirror,
-                                float envmapShare, int shareColumns, int productCdf, MA_LOCAL int* rows, int stride) {
+                                float envmapShare, int brdfCovers, int shareColumns, int productCdf, MA_LOCAL int* rows,
+                                int stride) {
   MA_CELL_LOOP
   for (int c = 0; c < count; ++c) pixelOptimalCellTerms(cells, count, c, b, normal, mirror, rows, stride);
   zeroChunkSums(count, rows, stride);
@@ -463,9 +468,9 @@ MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongPa
     for (int j = 0; j < chunksFrom(count, first); ++j)
       addToChunkEq6(count, j, eq6Term(cells, rows, stride, count, first + j, t), rows, stride);
   if (shareColumns) pixelOptimalShareScales(cells, count, rows, stride);
-  PixelTableScales s = pixelTableScales(rows, stride, count, t);
+  PixelTableScales s = pixelTableScales(rows, stride, count, t, brdfCovers);
   if (productCdf) {
-    ProductCdfTerms p = productCdfTerms(rows, stride, count);
+    ProductCdfTerms p = productCdfTerms(rows, stride, count, brdfCovers);
     pixelOptimalCdf(cells, count, p.t, p.s, 1, rows, stride);
   }
   pixelOptimalCdf(cells, count, t, s, 0, rows, stride);

@@ -101,6 +101,7 @@ typedef struct {
   PhongParams brdf;
   MaVec3 normal, mirror;
   float envmapShare;  // stageEnvmapShare
+  int brdfCovers;     // stageDrawsBrdf
 } PixelCdfInputs;
 
 MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride, int column, int stageSamples) {
@@ -116,6 +117,7 @@ MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride,
   c.n1 = pixelRows[ROW_N1 * rowStride + column];
   c.stageSamples = stageSamples;
   in.envmapShare = stageEnvmapShare(HAS_PRODUCT, c);
+  in.brdfCovers = stageDrawsBrdf(c);
   return in;
 #undef ROW_FLOAT
 }
@@ -262,7 +264,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   // The background takes no samples and needs no table.
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
     PixelCdfInputs in = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
-    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare,
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                          MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
                          MA_LOCAL_SIZE);
   }
@@ -406,7 +408,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
                   productWords, stageSamples, pixelOrder[first + lid]);
 #if MA_PIXEL_CELLS > 0
     PixelCdfInputs in = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples);
-    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare,
+    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                          MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
 #endif
   }

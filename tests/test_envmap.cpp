@@ -11,6 +11,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,14 +68,20 @@ std::vector<PixelOptimalPoint> pixelOptimalPoints() {
   };
 }
 
+// Whether a stage of envmap share C draws BRDF samples, without the product technique.
+bool drawsBrdf(float share) { return share < 1.0f; }
+
 // The view of `point`'s own table for a stage of envmap share C, in `rows`; with
-// productCdf, the product technique's CDF beside it (kernels/pixel_optimal.h).
+// productCdf, the product technique's CDF beside it (kernels/pixel_optimal.h). The
+// stage draws BRDF samples where brdfCovers says so, by default where C < 1.
 kern::EnvmapView pixelOptimalView(const EnvmapTables& tables, const PixelOptimalPoint& point, float share,
-                                  bool shareColumns, std::vector<int>& rows, bool productCdf = false) {
+                                  bool shareColumns, std::vector<int>& rows, bool productCdf = false,
+                                  std::optional<bool> brdfCovers = {}) {
   kern::EnvmapView view = viewOf(tables);
   rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells, productCdf), 0);
   kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror, share,
-                             shareColumns ? 1 : 0, productCdf ? 1 : 0, rows.data(), 1);
+                             brdfCovers.value_or(drawsBrdf(share)) ? 1 : 0, shareColumns ? 1 : 0, productCdf ? 1 : 0,
+                             rows.data(), 1);
   view.pixelCdf = rows.data();
   return view;
 }
@@ -545,15 +552,17 @@ TEST_CASE(
       for (bool isProduct : {false, true}) {
         INFO((isProduct ? "the product's table" : "the envmap's table"));
         const std::vector<double> p = pixelTexelProbabilities(isProduct ? both : view, isProduct);
-        // Where the stage draws BRDF samples (C < 1) the envmap's table is eq. 6's alone: a
-        // lit texel may be left out only with its cell, which eq. 6 clips and BRDF sampling
-        // covers. At C = 1, and in the product's table, the plain share keeps it drawable.
-        const bool brdfCovers = !isProduct && point.share < 1.0f;
+        // Where the stage draws BRDF samples (C < 1) the envmap's table is eq. 6's alone and
+        // the product's f/F alone: a lit texel may be left out only with its cell, which
+        // eq. 6 clips or the product's cells miss, and BRDF sampling covers. At C = 1 the
+        // plain share keeps it drawable.
+        const bool brdfCovers = drawsBrdf(point.share);
+        const kern::EnvmapView& table = isProduct ? product : view;
         double sum = 0;
         std::size_t unlit = 0;
         for (std::size_t t = 0; t < p.size(); ++t) {
           sum += p[t];
-          const bool clipped = brdfCovers && kern::pixelCellProbability(view, kern::blockOfTexel(view, int(t))) == 0;
+          const bool clipped = brdfCovers && kern::pixelCellProbability(table, kern::blockOfTexel(table, int(t))) == 0;
           unlit += plain[t] > 0 && !(p[t] > 0) && !clipped;
           clippedLit += plain[t] > 0 && clipped;
         }
@@ -569,9 +578,11 @@ TEST_CASE(
       }
       // The pdf a BRDF-sampled direction reads, by the midpoint rule.
       CHECK(std::abs(midpointPdfIntegral(view) - 1) <= 32 * kFloatRounding);
-      // The product is the envmap's table at C = 1, f/F ([CL18] from the cells), its chunks'
-      // masses rounded apart: each cell within a few steps of the CDF's grid.
-      const kern::EnvmapView shareOne = pixelOptimalView(tables, point, 1.0f, false, atShareOne);
+      // The product is the envmap's table at C = 1, f/F ([CL18] from the cells), with the
+      // stage's plain share, its chunks' masses rounded apart: each cell within a few steps
+      // of the CDF's grid.
+      const kern::EnvmapView shareOne =
+          pixelOptimalView(tables, point, 1.0f, false, atShareOne, false, drawsBrdf(point.share));
       double worst = 0;
       for (int c = 0; c < tables.pixelCells; ++c)
         worst = std::max(
@@ -646,8 +657,8 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   kern::EnvmapView view = viewOf(tables);
   std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells, 0));
   const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
-  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 0, 0,
-                             rows.data(), 1);
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 1, 0,
+                             0, rows.data(), 1);
   view.pixelCdf = rows.data();
   std::vector<double> p(std::size_t(tables.width) * tables.height);
   for (std::size_t t = 0; t < p.size(); ++t) p[t] = kern::texelProbability(view, int(t));
