@@ -57,7 +57,7 @@ TEST_CASE("stage sizes follow the pilot share and sum to the budget", "[adaptive
     CHECK(stageSizes(0.05, 2, 800, 2, m) == std::vector<int>{40, 380, 380});  // 5 % is above the floor
     CHECK(stageSizes(0.05, 1, 128, 2, m) == std::vector<int>{16, 112});
   }
-  // The per-pixel rules' fill passes of kPilotLanes per technique within a quarter of the budget.
+  // The per-pixel rules' fill passes of kPilotPassSamples per technique within a quarter of the budget.
   for (Method m : {Method::Heuristic, Method::SigmaSqrtC, Method::Linear}) {
     CHECK(stageSizes(0.05, 1, 200, 2, m) == std::vector<int>{32, 168});
     CHECK(stageSizes(0.05, 1, 200, 3, m) == std::vector<int>{48, 152});

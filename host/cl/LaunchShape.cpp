@@ -57,7 +57,7 @@ DeviceLimits deviceLimits(const cl::Device& device) {
     const int width =
         int(std::min<size_t>(device.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>(), limits.maxWorkGroupSize));
     limits.pixelLanes = 1;
-    while (limits.pixelLanes * 2 <= width) limits.pixelLanes *= 2;
+    while (limits.pixelLanes * 2 <= std::min(width, kMaxPixelLanes)) limits.pixelLanes *= 2;
   }
   return limits;
 }

@@ -19,11 +19,18 @@ struct DeviceLimits {
   // it leaves no lane idle. 1 where it does not matter (CPU).
   size_t preferredMultiple = 1;
   // CPU: its native float vector width (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), rounded
-  // down to a power of two: the lanes of samplePixelStage, which samples one pixel at a
-  // time across them.
+  // down to a power of two and at most kMaxPixelLanes: the lanes of samplePixelStage,
+  // which samples one pixel at a time across them.
   // 0 on other devices, which run sampleStage for every stage.
   int pixelLanes = 0;
 };
+
+// samplePixelStage runs each technique's n_k in whole passes of its lanes, so a pass of
+// 16 (AVX-512's float width) leaves up to 15 lanes idle per technique and pixel, and
+// exact's pilot of 8 per technique half of them. On an AVX-512 Zen 5, 8 lanes rendered
+// the same images 1.03–1.12× faster than 16 (docs/results.md, "Eight lanes on
+// AVX-512").
+inline constexpr int kMaxPixelLanes = 8;
 
 // A GPU's preferred multiple is its warp (cl_nv_device_attribute_query) or wavefront
 // (cl_amd_device_attribute_query) width where the device reports it, else 32: the

@@ -58,7 +58,7 @@ int pilotSamples(double pilotFraction, int spp, int techniqueCount, Method metho
     const int floor = kPilotSamplesPerTechnique * techniqueCount;
     return pilot < floor && 8 * floor <= spp ? floor : pilot;
   }
-  const int pass = kPilotLanes * techniqueCount, filled = (pilot + pass - 1) / pass * pass;
+  const int pass = kPilotPassSamples * techniqueCount, filled = (pilot + pass - 1) / pass * pass;
   return filled <= spp / 4 ? filled : pilot;
 }
 

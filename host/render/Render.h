@@ -59,12 +59,13 @@ struct AdaptiveOptions {
 inline constexpr int kPilotSamplesPerTechnique = 8;
 
 // The pilot of a method whose α is a per-pixel rule over running sums (heuristic,
-// sigma-sqrt-c, linear) fills whole passes of this many lanes per technique where that
-// keeps it within a quarter of the budget (pilotSamples): heuristic's and linear's
+// sigma-sqrt-c, linear) fills whole passes of this many samples per technique where
+// that keeps it within a quarter of the budget (pilotSamples): heuristic's and linear's
 // variance ratios, from 8 samples per technique, misjudged α (docs/results.md, "The
-// pilot's size by method"). On a CPU a pass of samplePixelStage costs the same however
-// many of its 16 lanes hold a sample (kernels/sample.cl).
-inline constexpr int kPilotLanes = 16;
+// pilot's size by method"). 16 was AVX-512's lanes in samplePixelStage when the rule
+// was made; it is the same on every device, so that every device renders the same
+// image.
+inline constexpr int kPilotPassSamples = 16;
 
 // The pilot's samples: f·N, at least two per technique, raised for `method` as the two
 // constants above say.

@@ -136,7 +136,7 @@ StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bo
 // Samples per technique that make each technique's samples in a launch of the covered
 // pixels take about max(10 ms, the launch's fixed time), the most that `capacity`
 // allows, from launches of 1 and kProbe samples per technique. Sized by the whole
-// launch instead, the shapes took 1 and 4 samples: on a CPU one pass of 16 lanes
+// launch instead, the shapes took 1 and 4 samples: on a CPU one pass of its lanes
 // each, the same work, and where the fixed time dominates (the optimal pdf per pixel
 // builds every pixel's table in each launch) the fitted costs were its noise. One
 // cached calibration priced the BRDF technique's samples 8x below the envmap's, against
@@ -145,7 +145,8 @@ StagePlan calibrationPlan(const Scene& scene, const std::vector<int>& counts, bo
 int calibrationSize(StageSampler& sampler, bool keepStatistics, int capacity) {
   const Scene& scene = sampler.scene();
   const int M = scene.techniqueCount();
-  // Past two passes of a CPU's 16 lanes, whose launches grow by whole passes.
+  // Past the first passes of a CPU's lanes (kMaxPixelLanes), whose launches grow by
+  // whole passes.
   constexpr int kProbe = 33;
   const int probe = std::clamp(capacity, 1, kProbe);
   const StagePlan one = calibrationPlan(scene, std::vector<int>(M, 1), keepStatistics),
