@@ -657,8 +657,8 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   kern::EnvmapView view = viewOf(tables);
   std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells, 0));
   const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
-  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 1, 0,
-                             0, rows.data(), 1);
+  kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 1, 0, 0,
+                             rows.data(), 1);
   view.pixelCdf = rows.data();
   std::vector<double> p(std::size_t(tables.width) * tables.height);
   for (std::size_t t = 0; t < p.size(); ++t) p[t] = kern::texelProbability(view, int(t));
@@ -875,11 +875,12 @@ TEST_CASE("the optimal pdf per pixel clips a cell by p_ρ's mass where its light
   REQUIRE(pointwise > 0);
   kern::PixelOptimalTerms terms;
   terms.invF = float(1 / F), terms.brdfScale = float((1 - C) / B), terms.lit = 1;
-  const float peakLight = kern::cellField(tables.blockProbs.data(), tables.pixelCells, cellIndex, kern::CELL_PEAK_LIGHT);
+  const float peakLight =
+      kern::cellField(tables.blockProbs.data(), tables.pixelCells, cellIndex, kern::CELL_PEAK_LIGHT);
   const float peakGap = kern::cellField(tables.blockProbs.data(), tables.pixelCells, cellIndex, kern::CELL_PEAK_GAP);
   const float term = kern::eq6Value(float(whole[0] * F), float(whole[1] / (1 - C) * B), peakLight, peakGap, terms);
   INFO("the cell's eq. 6 term over its texels': " << term / pointwise << " (peak: light " << peakLight << ", gap "
-                                                   << peakGap << ")");
+                                                  << peakGap << ")");
   CHECK(std::abs(term / pointwise - 1) <= 0.1);
 }
 

@@ -195,8 +195,9 @@ SamplerConfig samplerConfigFor(Method method, Estimator fixedSplitEstimator, int
   if (traits.searchesWeights) {
     // The grid searches keep running sums: the samples of one stage at a time are
     // stored, and the last stage stores none (the oracle's: its probe only).
-    config.sampleCapacity =
-        traits.split == Split::Probed ? options.oracleSamples : largestStatisticsStage(method, options, spp, techniqueCount);
+    config.sampleCapacity = traits.split == Split::Probed
+                                ? options.oracleSamples
+                                : largestStatisticsStage(method, options, spp, techniqueCount);
     config.gridSize = options.gridSize;
     config.runningSums = traits.split == Split::Staged && options.stages > 1;
     // Rule (b) judges each α_0 by the pdf of the share it would run (WeightGrid).

@@ -131,9 +131,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
       kern::buildPixelOptimalCdf(tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z,
-                                 kern::stageEnvmapShare(kern::productEnabled(ts.product), c),
-                                 kern::stageDrawsBrdf(c), ts.sharePdfs,
-                                 ts.product.pixelCells, pixelCdf.data(), 1);
+                                 kern::stageEnvmapShare(kern::productEnabled(ts.product), c), kern::stageDrawsBrdf(c),
+                                 ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(), 1);
       pixelEnv.pixelCdf = pixelCdf.data();
     }
     kern::PixelSums sums = kern::zeroPixelSums();
