@@ -17,5 +17,6 @@ namespace misalloc::kern {
 #include "gridsearch.h"
 #include "pixel.h"
 #include "pixel_layout.h"
+#include "pixel_pairs.h"
 #include "stats.h"
 }  // namespace misalloc::kern

@@ -19,9 +19,9 @@
 //
 // The build runs in passes over the cells and over MA_PIXEL_CHUNKS fixed chunks of them
 // (kernels/pixel_layout.h, chunkOfCell), its sums added chunk by chunk. Each work-item
-// builds its own pixel's table (sampleStage, and samplePixelStage's lanes one pixel
-// each), so the chunks no longer split one build among lanes; they remain the CDF's
-// order.
+// builds its own pixel's table, or its pair's (kernels/pixel_pairs.h), from the inputs
+// it is given (sampleStage, and samplePixelStage's lanes one pixel each), so the chunks
+// no longer split one build among lanes; they remain the CDF's order.
 //
 // A stage that stores its samples for the grid search of `exact` (kernels/stats.h, share
 // columns) also keeps the scales of the tables that stages of the shares C = 1/4, 1/2,

@@ -24,6 +24,7 @@
 // the same on PoCL and on the host, bit for bit (`--device cpu,host`, tests/test_devices.cpp).
 // It costs PoCL nothing measurable (README, "Sampling kernel against its OpenMP peer").
 #pragma OPENCL FP_CONTRACT OFF
+#include "pixel_pairs.h"
 #include "stats.h"
 
 #if MA_OPTIMAL_WEIGHTS && (MA_ONE_SAMPLE || MA_COUNT_INDEPENDENT)
@@ -96,30 +97,46 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
 #undef PIXEL_ROW
 }
 
-// What the optimal pdf per pixel is built from, read from the pixel's rows.
-typedef struct {
-  PhongParams brdf;
-  MaVec3 normal, mirror;
-  float envmapShare;  // stageEnvmapShare
-  int brdfCovers;     // stageDrawsBrdf
-} PixelCdfInputs;
-
+// What the optimal pdf per pixel is built from (kernels/pixel_pairs.h), read from the
+// pixel's rows.
 MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride, int column, int stageSamples) {
 #define ROW_FLOAT(row) as_float(pixelRows[(row)*rowStride + column])
-  PixelCdfInputs in;
-  in.brdf.rhoD = ROW_FLOAT(ROW_RHO_D);
-  in.brdf.rhoS = ROW_FLOAT(ROW_RHO_S);
-  in.brdf.n = ROW_FLOAT(ROW_N);
-  in.normal = makeVec3(ROW_FLOAT(ROW_NORMAL_X), ROW_FLOAT(ROW_NORMAL_Y), ROW_FLOAT(ROW_NORMAL_Z));
-  in.mirror = makeVec3(ROW_FLOAT(ROW_MIRROR_X), ROW_FLOAT(ROW_MIRROR_Y), ROW_FLOAT(ROW_MIRROR_Z));
+  PhongParams brdf;
+  brdf.rhoD = ROW_FLOAT(ROW_RHO_D);
+  brdf.rhoS = ROW_FLOAT(ROW_RHO_S);
+  brdf.n = ROW_FLOAT(ROW_N);
   StageCounts c;
   c.n0 = pixelRows[ROW_N0 * rowStride + column];
   c.n1 = pixelRows[ROW_N1 * rowStride + column];
   c.stageSamples = stageSamples;
-  in.envmapShare = stageEnvmapShare(HAS_PRODUCT, c);
-  in.brdfCovers = stageDrawsBrdf(c);
-  return in;
+  return cdfInputsOf(brdf, makeVec3(ROW_FLOAT(ROW_NORMAL_X), ROW_FLOAT(ROW_NORMAL_Y), ROW_FLOAT(ROW_NORMAL_Z)),
+                     makeVec3(ROW_FLOAT(ROW_MIRROR_X), ROW_FLOAT(ROW_MIRROR_Y), ROW_FLOAT(ROW_MIRROR_Z)), c,
+                     HAS_PRODUCT);
 #undef ROW_FLOAT
+}
+
+// Whether `pixel` samples its pair's table (kernels/pixel_pairs.h), given its own
+// inputs: its partner's are read from global memory, where their stage writes them.
+MA_FN int pixelPairsTables(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
+                           __global const uint* firstIndex, int stageSamples, int pixel, int scenePixels,
+                           PixelCdfInputs* partner) {
+  int q = pairPartner(pixel);
+  if (q >= scenePixels) return 0;
+  __global const float* point = shadingPoints + shadingPointOffset(q);
+  StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                  MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
+  PhongParams brdf;
+  brdf.rhoD = point[ROW_RHO_D];
+  brdf.rhoS = point[ROW_RHO_S];
+  brdf.n = point[ROW_N];
+  *partner = cdfInputsOf(brdf, makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
+                         makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
+  return pairsTables(own, *partner, pixelStageSamples(c) > 0, MA_SHARE_COLUMNS > 0, MA_PIXEL_CELLS);
+}
+
+// The inputs of the table that `pixel` samples: its pair's or its own.
+MA_FN PixelCdfInputs tableInputs(PixelCdfInputs own, int paired, PixelCdfInputs partner) {
+  return paired ? meanTableInputs(own, partner) : own;
 }
 
 // The one-sample estimator's pass: the stage's samples, none for the background
@@ -244,8 +261,8 @@ MA_FN void storeSample(__global float* samples, SampleContribution c, int kept, 
       __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,    \
       int width, int height, float coskExponent, __global const float *shadingPoints, __global const int *counts,  \
       __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixelCount, \
-      __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments, __global ma_acc *stats, \
-      __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
+      int scenePixels, __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments,             \
+      __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
@@ -263,7 +280,10 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 #if MA_PIXEL_CELLS > 0
   // The background takes no samples and needs no table.
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
-    PixelCdfInputs in = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
+    PixelCdfInputs own = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples), partner;
+    int paired =
+        pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, scenePixels, &partner);
+    PixelCdfInputs in = tableInputs(own, paired, partner);
     buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                          MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
                          MA_LOCAL_SIZE);
@@ -337,7 +357,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 // The same stage on a CPU, a work-group of L = MA_PIXEL_LANES lanes (the float vector
 // width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not
 // fit local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l
-// builds pixel l's table (the C++ reference's buildPixelOptimalCdf): the lanes read
+// builds pixel l's table (the C++ reference's buildPixelOptimalCdf), unless lane l − 1
+// builds the table that it samples (kernels/pixel_pairs.h): the lanes read
 // each cell at one address, and PoCL vectorises the build's first pass across cells.
 // Then the lanes sample the pixels one at a time: lane l takes samples l, L + l,
 // 2L + l, ... of each technique, so that PoCL vectorises across a pixel's samples.
@@ -376,19 +397,19 @@ MA_FN void addChunk(__local PixelSums* pixelSums, __local const float* terms, in
 enum { ROW_SAMPLED_PIXEL = ROW_PIXEL_CDF, ROW_SAMPLED_BLOCK, SAMPLED_ROWS };
 
 // Pixel q of the work-group, to be sampled: its inputs copied to pixelRows (row r at
-// r·PIXEL_ROW_STRIDE), there read at fixed addresses, and its index and block read
-// back from local memory. q is kept per lane across the barriers, and PoCL cannot tell
+// r·PIXEL_ROW_STRIDE), there read at fixed addresses, and its index and the block of
+// its table (its own, or its partner's: tableLane) read back from local memory. q is kept per lane across the barriers, and PoCL cannot tell
 // that it is the same in every lane: rows read at q would be gathers, and what the
 // sample loop computes once from the pixel's index (its Philox key, 64-bit products)
 // would be kept per lane and hold the loop to 4 lanes (docs/pocl.md, rule 10). Read
 // back from local memory after the barrier, each is one value for the work-group.
-MA_FN void copySampledPixel(__local int* pixelRows, __local const int* groupRows, __global const int* pixelOrder,
-                            int first, int q, int lid) {
+MA_FN void copySampledPixel(__local int* pixelRows, __local const int* groupRows, __local const int* tableLane,
+                            __global const int* pixelOrder, int first, int q, int lid) {
   for (int r = lid; r < ROW_PIXEL_CDF; r += MA_PIXEL_LANES)
     pixelRows[r * PIXEL_ROW_STRIDE] = groupRows[(q * ROW_BLOCK) ^ r];
   if (lid == 0) {
     pixelRows[ROW_SAMPLED_PIXEL * PIXEL_ROW_STRIDE] = pixelOrder[first ^ q];
-    pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] = q * ROW_BLOCK;
+    pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] = tableLane[q] * ROW_BLOCK;
   }
   barrier(CLK_LOCAL_MEM_FENCE);
 }
@@ -402,19 +423,28 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
   int pixels = min(MA_GROUP_PIXELS, pixelCount - first);
   // Lane l loads pixel l of the work-group and builds its table as the C++ reference
   // does: the lanes build their tables side by side, each reading the cells at the same
-  // addresses.
+  // addresses. A pixel whose pair's table the lane before builds (its partner, sorted
+  // next to it by its counts) samples that table instead.
+  __local int tableLane[MA_GROUP_PIXELS];
   if (lid < pixels) {
+    int pixel = pixelOrder[first + lid];
     loadPixelRows(groupRows, 1, lid * ROW_BLOCK, shadingPoints, counts, firstIndex, MA_COEFFICIENTS, productFloats,
-                  productWords, stageSamples, pixelOrder[first + lid]);
+                  productWords, stageSamples, pixel);
+    int lane = lid;
 #if MA_PIXEL_CELLS > 0
-    PixelCdfInputs in = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples);
-    buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
-                         MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
+    PixelCdfInputs own = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples), partner;
+    int paired = pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, scenePixels, &partner);
+    if (paired && lid > 0 && pixelOrder[first + lid - 1] == pairPartner(pixel)) lane = lid - 1;
+    PixelCdfInputs in = tableInputs(own, paired, partner);
+    if (lane == lid)
+      buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
+                           MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);
 #endif
+    tableLane[lid] = lane;
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   for (int q = 0; q < pixels; ++q) {
-    copySampledPixel(pixelRows, groupRows, pixelOrder, first, q, lid);
+    copySampledPixel(pixelRows, groupRows, tableLane, pixelOrder, first, q, lid);
     int pixel = pixelRows[ROW_SAMPLED_PIXEL * PIXEL_ROW_STRIDE];
     __local const int* cdfRows = groupRows + pixelRows[ROW_SAMPLED_BLOCK * PIXEL_ROW_STRIDE] + ROW_PIXEL_CDF;
     if (lid == 0) pixelSums = zeroPixelSums();

@@ -18,6 +18,7 @@
 #include "TestSize.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
+#include "sampling/KernelViews.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -85,6 +86,11 @@ struct OffAxisCase {
 std::vector<OffAxisCase> offAxisCases() {
   if (smallTestSize()) return {{{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}};
   return {{{1, 0, 0}, 30, 1}, {{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}, {{0.6, 0, -0.8}, 45, 0.5}};
+}
+
+Vec3d unitVector(const Vec3d& v) {
+  const double l = std::sqrt(dot(v, v));
+  return {v[0] / l, v[1] / l, v[2] / l};
 }
 
 // Normal `normal` seen from `viewDegrees` off it.
@@ -200,6 +206,40 @@ TEST_CASE("the optimal pdf per pixel is unbiased in frames off the map's axis, a
     const double expected = quadratureValue(c.K, kRhoD, kRhoS, kN, frameAt(c.normal, c.view));
     for (Estimator e : {Estimator::MultiSample, Estimator::OneSample, Estimator::CountIndependent})
       addSized(family, fmt::format("{}: equal estimator {}", offAxisName(c), int(e)), expected, 64, 4, ++seed,
+               [&](int spp, uint64_t sd) { return renderMean(scene, Method::Equal, e, spp, sd); });
+  }
+  checkFamily(family);
+}
+
+TEST_CASE("the optimal pdf per pixel is unbiased where pairs of pixels share a table, against a quadrature",
+          "[geometry][unbiased][optimal][pairs]") {
+  // Pixel 2k + 1's normal is pixel 2k's turned by 1.5° and its exponent 3 % larger: each
+  // pair samples the table of their mean inputs (kernels/pixel_pairs.h), which is
+  // neither pixel's own. The image's mean is the mean of both frames' quadratures.
+  BiasFamily family(0.02);
+  uint64_t seed = 3200;
+  for (const OffAxisCase& c : offAxisCases()) {
+    Scene scene = pixelOptimalOffAxisScene(c, false);
+    const Vec3d t = basisAbout(c.normal)[0];
+    const Vec3d turned =
+        unitVector({c.normal[0] + 0.026 * t[0], c.normal[1] + 0.026 * t[1], c.normal[2] + 0.026 * t[2]});
+    const PixelFrame even = frameAt(c.normal, c.view), odd = frameAt(turned, c.view);
+    for (int p = 1; p < scene.pixelCount(); p += 2) {
+      scene.geometry.pixels[size_t(p)] = odd;
+      scene.grid.pixels[size_t(p)].n = float(kN * 1.03);
+    }
+    const StagePlan plan = singleStagePlan(scene, Method::Equal, 64);
+    auto inputs = [&](int p) {
+      const kern::StageCounts counts =
+          kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), p, 2, 64, 0, 0, 1);
+      const kern::ShadingPoint sp = makeShadingPoint(scene, p);
+      return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, counts, 0);
+    };
+    REQUIRE(kern::pairsTables(inputs(0), inputs(1), 1, 0, scene.tables.pixelCells));
+    const double expected =
+        0.5 * (quadratureValue(c.K, kRhoD, kRhoS, kN, even) + quadratureValue(c.K, kRhoD, kRhoS, kN * 1.03, odd));
+    for (Estimator e : {Estimator::MultiSample, Estimator::OneSample})
+      addSized(family, fmt::format("{}, pairs: equal estimator {}", offAxisName(c), int(e)), expected, 64, 4, ++seed,
                [&](int spp, uint64_t sd) { return renderMean(scene, Method::Equal, e, spp, sd); });
   }
   checkFamily(family);

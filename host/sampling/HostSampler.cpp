@@ -71,6 +71,32 @@ kern::OptimalCoefficients optimalCoefficients(const StagePlan& plan, int pixel, 
   return a;
 }
 
+kern::StageCounts stageCountsOf(const StagePlan& plan, const SamplerConfig& config, int pixel) {
+  return kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, plan.techniqueCount,
+                               plan.stageSamples, config.estimator == Estimator::OneSample,
+                               config.estimator == Estimator::CountIndependent, config.risCandidates);
+}
+
+kern::PixelCdfInputs cdfInputsOf(const Scene& scene, const kern::StageCounts& c, int pixel, int product) {
+  const kern::ShadingPoint sp = makeShadingPoint(scene, pixel);
+  return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, product);
+}
+
+// The inputs of the table that `pixel` samples: its pair's or its own
+// (kernels/pixel_pairs.h), as kernels/sample.cl's pixelPairsTables chooses.
+kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, const SamplerConfig& config, int pixel,
+                                 const kern::TechniqueSet& ts, int cells) {
+  const int product = kern::productEnabled(ts.product);
+  const kern::PixelCdfInputs own = cdfInputsOf(scene, stageCountsOf(plan, config, pixel), pixel, product);
+  const int q = kern::pairPartner(pixel);
+  if (q >= scene.pixelCount()) return own;
+  const kern::StageCounts c = stageCountsOf(plan, config, q);
+  const kern::PixelCdfInputs partner = cdfInputsOf(scene, c, q, product);
+  return kern::pairsTables(own, partner, kern::pixelStageSamples(c) > 0, ts.sharePdfs, cells)
+             ? kern::meanTableInputs(own, partner)
+             : own;
+}
+
 }  // namespace
 
 HostSampler::HostSampler(const Scene& scene, const SamplerConfig& config)
@@ -123,16 +149,14 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     const kern::ShadingPoint sp = makeShadingPoint(scene_, pixel);
     kern::TechniqueSet pixelTs = ts;
     if (ts.product.tables > 0) pixelTs.productMixture = kern::productMixture(ts.product, sp.brdf);
-    const kern::StageCounts c =
-        kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel, M, plan.stageSamples,
-                              config_.estimator == Estimator::OneSample,
-                              config_.estimator == Estimator::CountIndependent, config_.risCandidates);
+    const kern::StageCounts c = stageCountsOf(plan, config_, pixel);
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
-      kern::buildPixelOptimalCdf(tables.blockProbs.data(), env.pixelCells, sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z,
-                                 kern::stageEnvmapShare(kern::productEnabled(ts.product), c), kern::stageDrawsBrdf(c),
-                                 ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(), 1);
+      const kern::PixelCdfInputs in = tableInputs(scene_, plan, config_, pixel, ts, env.pixelCells);
+      kern::buildPixelOptimalCdf(tables.blockProbs.data(), env.pixelCells, in.brdf, in.normal, in.mirror,
+                                 in.envmapShare, in.brdfCovers, ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(),
+                                 1);
       pixelEnv.pixelCdf = pixelCdf.data();
     }
     kern::PixelSums sums = kern::zeroPixelSums();

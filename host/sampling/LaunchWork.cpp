@@ -4,11 +4,16 @@
 
 namespace misalloc {
 
-std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
+std::vector<int32_t> sampledPixels(const StagePlan& plan, PixelRange range) {
   std::vector<int32_t> order;
   order.reserve(size_t(range.size()));
   for (int p = range.begin; p < range.end; ++p)
     if (takesSamples(plan, p)) order.push_back(p);
+  return order;
+}
+
+std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range) {
+  std::vector<int32_t> order = sampledPixels(plan, range);
   const size_t M = size_t(plan.techniqueCount);
   auto before = [&](int32_t a, int32_t b) {
     const int* countsA = plan.counts.data() + size_t(a) * M;

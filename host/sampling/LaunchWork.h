@@ -8,7 +8,13 @@
 
 namespace misalloc {
 
-// The order in which work-items take the pixels of `range`. A work-group runs each
+// The pixels of `range` that take samples this stage, in index order: samplePixelStage's
+// (kernels/sample.cl), whose lanes sample one pixel at a time, so that like counts gain
+// nothing, and a pair of pixels that samples one table (kernels/pixel_pairs.h) lies side
+// by side, where one lane builds it for both.
+std::vector<int32_t> sampledPixels(const StagePlan& plan, PixelRange range);
+
+// The order in which sampleStage's work-items take the pixels of `range`. A work-group runs each
 // technique's loop for its largest count (kernels/sample.cl, sampleStage), so pixels
 // with like counts share work-groups: sorted by (n_0, …, n_{M−2}) with a stable sort,
 // ties by index; n_{M−1} = N − the rest. Each pixel's arithmetic does not depend on its

@@ -204,7 +204,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
 }
 
 StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
-  return runOrder(plan, seed, firstSlot, range, coherentPixelOrder(plan, range));
+  const bool statistics = plan.keepStatistics && keepsStatistics(config_);
+  return runOrder(plan, seed, firstSlot, range,
+                  pixelLanes(statistics) > 0 ? sampledPixels(plan, range) : coherentPixelOrder(plan, range));
 }
 
 StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range,
@@ -234,8 +236,8 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   bind(env.texels, env.cdfTable, env.aliasTable, env.blockProbs, b.productFloats, b.productWords,
        cl_int(scene_.tables.width), cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints,
        counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
-       cl_int(scene_.firstPixel), cl_int(order.size()), pixelOrder_, rgb_, moments_, stats_, samples_,
-       cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
+       cl_int(scene_.firstPixel), cl_int(order.size()), cl_int(scene_.pixelCount()), pixelOrder_, rgb_, moments_,
+       stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
   const size_t groups = lanes > 0 ? (order.size() + size_t(groupPixels_) - 1) / size_t(groupPixels_) : 0;

@@ -1,0 +1,204 @@
+// Pairs of pixels that sample one per-pixel table (kernels/pixel_pairs.h): when they
+// pair, that both build the same table, that the kernels pair them as the C++ reference
+// does, and that the estimate stays unbiased.
+#include <fmt/format.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+
+#include "BiasCheck.h"
+#include "KernelCode.h"
+#include "SceneFixtures.h"
+#include "TestDevice.h"
+#include "render/Render.h"
+#include "sampling/HostSampler.h"
+#include "sampling/KernelViews.h"
+
+using namespace misalloc;
+using namespace misalloc::test;
+
+namespace {
+
+constexpr int kCells = 32 * 16;  // the default table's: a cell spans Δ = 11.25°
+
+kern::MaVec3 unit(double x, double y, double z) {
+  const double l = std::sqrt(x * x + y * y + z * z);
+  return kern::makeVec3(float(x / l), float(y / l), float(z / l));
+}
+
+// v turned by `degrees` towards the x axis about the axis v × x (v not along x).
+kern::MaVec3 turned(kern::MaVec3 v, double degrees) {
+  const double a = degrees * kPi / 180;
+  // The unit vector in the plane of v and x, orthogonal to v.
+  const double d = v.x;
+  kern::MaVec3 u = unit(1 - d * v.x, -d * v.y, -d * v.z);
+  return unit(std::cos(a) * v.x + std::sin(a) * u.x, std::cos(a) * v.y + std::sin(a) * u.y,
+              std::cos(a) * v.z + std::sin(a) * u.z);
+}
+
+kern::PixelCdfInputs glossyInputs() {
+  kern::PixelCdfInputs in;
+  in.brdf = {0.3f, 0.6f, 1e4f};
+  in.normal = unit(0.1, 0.2, 1);
+  in.mirror = unit(-0.3, 0.4, 1);
+  in.envmapShare = 0.5f;
+  in.brdfCovers = 1;
+  return in;
+}
+
+bool pairs(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
+  return kern::pairsTables(a, b, 1, 0, kCells);
+}
+
+bool sameBits(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
+  const float fa[] = {a.brdf.rhoD, a.brdf.rhoS, a.brdf.n,   a.normal.x, a.normal.y,
+                      a.normal.z,  a.mirror.x,  a.mirror.y, a.mirror.z, a.envmapShare};
+  const float fb[] = {b.brdf.rhoD, b.brdf.rhoS, b.brdf.n,   b.normal.x, b.normal.y,
+                      b.normal.z,  b.mirror.x,  b.mirror.y, b.mirror.z, b.envmapShare};
+  return std::memcmp(fa, fb, sizeof fa) == 0 && a.brdfCovers == b.brdfCovers;
+}
+
+}  // namespace
+
+TEST_CASE("two pixels share a table only where their inputs are alike", "[pairs]") {
+  const kern::PixelCdfInputs a = glossyInputs();
+  CHECK(pairs(a, a));
+  // Neither the stage's share columns nor a partner without samples.
+  CHECK_FALSE(kern::pairsTables(a, a, 0, 0, kCells));
+  CHECK_FALSE(kern::pairsTables(a, a, 1, 1, kCells));
+  // One draws BRDF samples and the other none: the table's plain share differs, and
+  // without it the second's texels that eq. 6 clips could not be drawn.
+  kern::PixelCdfInputs b = a;
+  b.brdfCovers = 0;
+  CHECK_FALSE(pairs(a, b));
+  // The envmap share within 1/16.
+  b = a, b.envmapShare = 0.55f;
+  CHECK(pairs(a, b));
+  b.envmapShare = 0.57f;
+  CHECK_FALSE(pairs(a, b));
+  // Each BRDF parameter within 5 % of the pair's mean.
+  for (float kern::PhongParams::*p : {&kern::PhongParams::rhoD, &kern::PhongParams::rhoS, &kern::PhongParams::n}) {
+    b = a, b.brdf.*p = a.brdf.*p * 1.045f;
+    CHECK(pairs(a, b));
+    b.brdf.*p = a.brdf.*p * 1.06f;
+    CHECK_FALSE(pairs(a, b));
+  }
+  // Normals within Δ/4 = 2.81°.
+  b = a, b.normal = turned(a.normal, 2.7);
+  CHECK(pairs(a, b));
+  b.normal = turned(a.normal, 2.9);
+  CHECK_FALSE(pairs(a, b));
+  // Mirror directions within the lobe's width as the table spreads it: √(1/n + Δ²/12),
+  // 3.29° at n = 10⁴, 18.1° at n = 10.
+  b = a, b.mirror = turned(a.mirror, 3.2);
+  CHECK(pairs(a, b));
+  b.mirror = turned(a.mirror, 3.4);
+  CHECK_FALSE(pairs(a, b));
+  kern::PixelCdfInputs rough = a;
+  rough.brdf.n = 10;
+  b = rough, b.mirror = turned(a.mirror, 17.5);
+  CHECK(pairs(rough, b));
+  b.mirror = turned(a.mirror, 18.7);
+  CHECK_FALSE(pairs(rough, b));
+}
+
+TEST_CASE("both pixels of a pair build the same table", "[pairs]") {
+  // Inputs scattered about one pixel's: whichever pixel asks, the answer and the mean
+  // are the same, bit for bit.
+  const kern::PixelCdfInputs a = glossyInputs();
+  int paired = 0;
+  for (uint32_t i = 0; i < 400; ++i) {
+    const kern::MaRandom4 r = kern::philoxDraw(0x9a1, 0, 17u, 3u, i);
+    auto unitFloat = [&](int k) { return (double(r.v[k]) + 0.5) / 4294967296.0; };
+    kern::PixelCdfInputs b = a;
+    b.normal = turned(a.normal, 4 * unitFloat(0));
+    b.mirror = turned(a.mirror, 5 * unitFloat(1));
+    b.brdf.n = float(a.brdf.n * (0.94 + 0.12 * unitFloat(2)));
+    b.envmapShare = float(0.4 + 0.2 * unitFloat(3));
+    const bool ab = pairs(a, b);
+    CHECK(ab == pairs(b, a));
+    paired += ab;
+    CHECK(sameBits(kern::meanTableInputs(a, b), kern::meanTableInputs(b, a)));
+  }
+  // Both answers come up.
+  CHECK(paired > 20);
+  CHECK(paired < 380);
+}
+
+namespace {
+
+// A scene whose even pixels have random frames and whose pixel 2k + 1 is pixel 2k turned
+// by a little (they pair) or by too much (every third pair), with an exponent 3 % apart.
+Scene pairedScene(const std::string& map, int width, int height, bool product) {
+  Scene scene =
+      smallScene(map, "uniform:0.3,0.6,200", width, height, false, EnvmapSampler::Alias, 0, "optimal-pixel", product);
+  giveRandomFrames(scene, 11);
+  for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
+    const PixelFrame& f = scene.geometry.pixels[size_t(p)];
+    const double degrees = (p / 2) % 3 == 2 ? 6.0 : 1.0;
+    const kern::MaVec3 n = turned(kern::makeVec3(f.normal[0], f.normal[1], f.normal[2]), degrees);
+    const kern::MaVec3 m = turned(kern::makeVec3(f.mirror[0], f.mirror[1], f.mirror[2]), degrees);
+    scene.geometry.pixels[size_t(p) + 1] = {{n.x, n.y, n.z}, {m.x, m.y, m.z}};
+    scene.grid.pixels[size_t(p) + 1].n *= 1.03f;
+  }
+  scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
+  return scene;
+}
+
+}  // namespace
+
+TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit for bit", "[pairs][sampler]") {
+  // sampleStage runs the stages that keep running sums; samplePixelStage, on a CPU, the
+  // others, where a pair in adjacent lanes builds its table once. Background among the
+  // pixels, and counts that differ between pairs and within every fifth.
+  for (bool product : {false, true}) {
+    Scene scene = pairedScene("venice_sunset", 24, 16, product);
+    giveBackground(scene, 7);
+    StagePlan plan = singleStagePlan(scene, Method::Equal, 40);
+    const int M = plan.techniqueCount;
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      int32_t* n = plan.counts.data() + size_t(p) * M;
+      const int pair = p / 2, product = M == 3 ? 5 : 0;
+      n[0] = 10 + (pair * 7) % 20 + (pair % 5 == 4 ? p % 2 : 0);
+      // Every seventh pair: one pixel draws no BRDF samples, the other two, at envmap
+      // shares 1/16 apart.
+      if (pair % 7 == 6) n[0] = 40 - product - 2 * (p % 2);
+      n[1] = 40 - product - n[0];
+      if (M == 3) n[2] = product;
+    }
+    leaveOutBackground(scene, plan.counts);
+    // Which pairs pair in this plan: some do, some do not.
+    int paired = 0, unpaired = 0;
+    for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
+      auto inputs = [&](int q) {
+        const kern::StageCounts c =
+            kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), q, M, plan.stageSamples, 0, 0, 1);
+        const kern::ShadingPoint sp = makeShadingPoint(scene, q);
+        return std::make_pair(kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, product),
+                              kern::pixelStageSamples(c) > 0);
+      };
+      const auto [a, aSamples] = inputs(p);
+      const auto [b, bSamples] = inputs(p + 1);
+      if (!aSamples || !bSamples) continue;
+      (kern::pairsTables(a, b, 1, 0, scene.tables.pixelCells) ? paired : unpaired) += 1;
+    }
+    CHECK(paired > 10);
+    CHECK(unpaired > 10);
+    const SamplerConfig config{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 0};
+    Sampler device(testDevice(), scene, config);
+    HostSampler host(scene, config);
+    size_t mismatches = 0;
+    for (int stage = 0; stage < 2; ++stage) {
+      StagePlan s = plan;
+      s.keepStatistics = stage == 0;
+      s.samplesBefore = 40 * stage;
+      for (size_t i = 0; i < plan.counts.size(); ++i) s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
+      StageResult a = device.run(s, 7), b = host.run(s, 7);
+      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+    }
+    INFO("product " << product);
+    CHECK(mismatches == 0);
+  }
+}
