@@ -1,14 +1,14 @@
-// Pixels 2k and 2k + 1, side by side in a row, sample one per-pixel table where their
-// tables would be alike (kernels/pixel_optimal.h): built from the mean of their inputs,
-// it costs half a build each. Neighbours on a smooth surface differ by a fraction of a
+// Pixels x = 2k and 2k + 1 of a row sample one per-pixel table where their tables
+// would be alike (kernels/pixel_optimal.h): built from the mean of their inputs, it
+// costs half a build each. Neighbours on a smooth surface differ by a fraction of a
 // cell; the table cannot tell them apart much better than that. Any table with the
 // coverage rule keeps the estimator unbiased, and the pair's keeps it: both pixels draw
 // BRDF samples (which cover their own f), or neither does (the table's plain share
-// covers every lit texel). The pair is fixed by the pixels' indices, so a pixel's table
-// does not depend on the launch that samples it: its work-group, its device, its band
-// (a band starts on an even pixel: render/Band.h, whole rows of 16-pixel blocks). A
-// stage that stores share columns (kernels/stats.h) keeps each pixel's own table: its
-// samples carry pdfs recomputed from the pixel's own inputs.
+// covers every lit texel). The pair is fixed by the pixels' places in their row, so a
+// pixel's table does not depend on the launch that samples it: its work-group, its
+// device's tiles, its band (whole rows: render/Band.h). A stage that stores share
+// columns (kernels/stats.h) keeps each pixel's own table: its samples carry pdfs
+// recomputed from the pixel's own inputs.
 #include "namespace_check.h"
 #ifndef MA_PIXEL_PAIRS_H
 #define MA_PIXEL_PAIRS_H
@@ -34,7 +34,12 @@ MA_FN PixelCdfInputs cdfInputsOf(PhongParams brdf, MaVec3 normal, MaVec3 mirror,
   return in;
 }
 
-MA_FN int pairPartner(int pixel) { return pixel ^ 1; }
+// The other pixel of `pixel`'s pair, in an image `width` pixels wide; −1 for the last
+// pixel of a row of odd width.
+MA_FN int pairPartner(int pixel, int width) {
+  int x = pixel % width, other = x ^ 1;
+  return other < width ? pixel - x + other : -1;
+}
 
 // Within 5 % of their mean.
 MA_FN int alikeValues(float a, float b) { return ma_abs(a - b) <= 0.025f * (a + b); }

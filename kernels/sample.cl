@@ -118,10 +118,10 @@ MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride,
 // Whether `pixel` samples its pair's table (kernels/pixel_pairs.h), given its own
 // inputs: its partner's are read from global memory, where their stage writes them.
 MA_FN int pixelPairsTables(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
-                           __global const uint* firstIndex, int stageSamples, int pixel, int scenePixels,
+                           __global const uint* firstIndex, int stageSamples, int pixel, int imageWidth,
                            PixelCdfInputs* partner) {
-  int q = pairPartner(pixel);
-  if (q >= scenePixels) return 0;
+  int q = pairPartner(pixel, imageWidth);
+  if (q < 0) return 0;
   __global const float* point = shadingPoints + shadingPointOffset(q);
   StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                   MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
@@ -261,7 +261,7 @@ MA_FN void storeSample(__global float* samples, SampleContribution c, int kept, 
       __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,    \
       int width, int height, float coskExponent, __global const float *shadingPoints, __global const int *counts,  \
       __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixelCount, \
-      int scenePixels, __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments,             \
+      int imageWidth, __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments,             \
       __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(MA_SAMPLE_STAGE_PARAMETERS) {
@@ -282,7 +282,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
     PixelCdfInputs own = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples), partner;
     int paired =
-        pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, scenePixels, &partner);
+        pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth, &partner);
     PixelCdfInputs in = tableInputs(own, paired, partner);
     buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                          MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
@@ -433,8 +433,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
     int lane = lid;
 #if MA_PIXEL_CELLS > 0
     PixelCdfInputs own = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples), partner;
-    int paired = pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, scenePixels, &partner);
-    if (paired && lid > 0 && pixelOrder[first + lid - 1] == pairPartner(pixel)) lane = lid - 1;
+    int paired = pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth, &partner);
+    if (paired && lid > 0 && pixelOrder[first + lid - 1] == pairPartner(pixel, imageWidth)) lane = lid - 1;
     PixelCdfInputs in = tableInputs(own, paired, partner);
     if (lane == lid)
       buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,

@@ -109,6 +109,34 @@ TEST_CASE("merged bands are the unsharded render bit for bit, for every method",
   }
 }
 
+TEST_CASE("bands of an odd width merge bit for bit where pairs of pixels share a table", "[band][cli][pairs]") {
+  // A uniform plane with the optimal pdf per pixel: every pair of a row shares a table
+  // (kernels/pixel_pairs.h). 15 pixels wide with a halo of one row, the bands start on
+  // odd pixels: pairs taken by index instead of by their place in the row differ
+  // there, and the halo's pilot reaches the band's first row through the pooling.
+  TempDir dir("band-pairs");
+  const std::string scene =
+      "--scene plane --grid uniform:0.3,0.6,50 --envmap-pdf optimal-pixel --size 15x40 --method heuristic --pool 1";
+  auto args = [&](const std::string& extra) {
+    return fmt::format("render --envmap sun --spp 48 {} --cost 1,1.5 --device cpu --reference none --no-preview "
+                       "--report {} {}",
+                       scene, (dir.path / "report.json").string(), extra);
+  };
+  auto whole = runMisalloc(args("--out " + (dir.path / "whole.exr").string()));
+  INFO(whole.output);
+  REQUIRE(whole.exitCode == 0);
+  for (int k = 0; k < 3; ++k) {
+    auto r = runMisalloc(args(fmt::format("--shard {}/3 --out {}", k, bandPath(dir.path, k))));
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+  }
+  auto merged =
+      runMisalloc(mergeArgs(dir.path, "merged", {bandPath(dir.path, 0), bandPath(dir.path, 1), bandPath(dir.path, 2)}));
+  INFO(merged.output);
+  REQUIRE(merged.exitCode == 0);
+  CHECK(readText(dir.path / "merged.exr") == readText(dir.path / "whole.exr"));
+}
+
 TEST_CASE("a band leaves the optimal pdf's cached tables to the whole image", "[band][cli][bankcache]") {
   TempDir dir("band_cache");
   const std::string cold = "--cache-dir " + (dir.path / "cache").string();

@@ -131,6 +131,22 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
   CHECK(pairs["cpu,host"]->name().find(kHostSamplerName) != std::string::npos);
 }
 
+TEST_CASE("two devices render the image of one where pairs of pixels cross a tile's edge", "[devices][pairs]") {
+  // 15 pixels wide: the tiles of 16 pixels cut rows, so a pair of pixels that shares a
+  // table (kernels/pixel_pairs.h) can lie in two tiles, and a device reads the counts
+  // of its tile's neighbour. Exponents 1.3 % apart across the plane: every pair of a row
+  // shares, and its table is neither pixel's own.
+  const Scene scene =
+      smallScene("sun", "general:0.3,0.3,50,60", 15, 26, false, EnvmapSampler::Alias, 0, "optimal-pixel");
+  SamplerDevices one("cpu"), two(twoCpuDevices());
+  for (Method method : {Method::Equal, Method::Heuristic}) {
+    INFO(methodName(method));
+    Rendering a = renderOn(one, scene, method, Estimator::MultiSample, 40);
+    Rendering b = renderOn(two, scene, method, Estimator::MultiSample, 40);
+    CHECK(sameBits(a.image, b.image));
+  }
+}
+
 TEST_CASE("a failed device's tiles run again on the others: the same image", "[devices]") {
   const Scene scene = smallScene("studio_small_03", "seed000", 40, 26);
   int injected = 0;

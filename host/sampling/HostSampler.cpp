@@ -88,8 +88,8 @@ kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, cons
                                  const kern::TechniqueSet& ts, int cells) {
   const int product = kern::productEnabled(ts.product);
   const kern::PixelCdfInputs own = cdfInputsOf(scene, stageCountsOf(plan, config, pixel), pixel, product);
-  const int q = kern::pairPartner(pixel);
-  if (q >= scene.pixelCount()) return own;
+  const int q = kern::pairPartner(pixel, scene.grid.width);
+  if (q < 0) return own;
   const kern::StageCounts c = stageCountsOf(plan, config, q);
   const kern::PixelCdfInputs partner = cdfInputsOf(scene, c, q, product);
   return kern::pairsTables(own, partner, kern::pixelStageSamples(c) > 0, ts.sharePdfs, cells)

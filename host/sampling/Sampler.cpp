@@ -214,7 +214,10 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   const int M = scene_.techniqueCount();
   StageResult result;
   if (range.size() == 0) return result;
-  const size_t rows = kern::countsOffset(range.size(), M), firstRow = kern::countsOffset(range.begin, M);
+  // With the pixels' counts beside the range, where a pair across its edge reads its
+  // partner's (kernels/pixel_pairs.h): a tile of 16 pixels need not start a row.
+  const PixelRange written{std::max(0, range.begin - 1), std::min(scene_.pixelCount(), range.end + 1)};
+  const size_t rows = kern::countsOffset(written.size(), M), firstRow = kern::countsOffset(written.begin, M);
   const cl::CommandQueue& queue = device_.queue;
   queue.enqueueWriteBuffer(counts_, CL_FALSE, firstRow * sizeof(int32_t), rows * sizeof(int32_t),
                            plan.counts.data() + firstRow);
@@ -236,7 +239,7 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   bind(env.texels, env.cdfTable, env.aliasTable, env.blockProbs, b.productFloats, b.productWords,
        cl_int(scene_.tables.width), cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints,
        counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
-       cl_int(scene_.firstPixel), cl_int(order.size()), cl_int(scene_.pixelCount()), pixelOrder_, rgb_, moments_,
+       cl_int(scene_.firstPixel), cl_int(order.size()), cl_int(scene_.grid.width), pixelOrder_, rgb_, moments_,
        stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
