@@ -62,6 +62,15 @@ MA_FN ProductView productView(__global const float* productFloats, __global cons
   return p;
 }
 
+// The BRDF of the shading point at `point` (shadingPointOffset).
+MA_FN PhongParams pointBrdf(__global const float* point) {
+  PhongParams brdf;
+  brdf.rhoD = point[ROW_RHO_D];
+  brdf.rhoS = point[ROW_RHO_S];
+  brdf.n = point[ROW_N];
+  return brdf;
+}
+
 // Writes what a pixel's samples share into its rows: row r at pixelRows[r·rowStride + column].
 MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __global const float* shadingPoints,
                          __global const int* counts, __global const uint* firstIndex,
@@ -85,11 +94,7 @@ MA_FN void loadPixelRows(__local int* pixelRows, int rowStride, int column, __gl
     PIXEL_ROW(ROW_COEFFICIENTS + r) = as_int(coefficients[coefficientsOffset(pixel, MA_TECHNIQUES) + r]);
 #endif
 #if MA_PRODUCT_TABLES > 0
-  PhongParams phong;
-  phong.rhoD = point[ROW_RHO_D];
-  phong.rhoS = point[ROW_RHO_S];
-  phong.n = point[ROW_N];
-  ProductMixture mixture = productMixture(productView(productFloats, productWords), phong);
+  ProductMixture mixture = productMixture(productView(productFloats, productWords), pointBrdf(point));
   PIXEL_ROW(ROW_PRODUCT) = as_int(mixture.diffuse);
   PIXEL_ROW(ROW_PRODUCT + 1) = as_int(mixture.specular);
   PIXEL_ROW(ROW_PRODUCT + 2) = mixture.specularTable;
@@ -125,11 +130,7 @@ MA_FN int pixelPairsTables(PixelCdfInputs own, __global const float* shadingPoin
   __global const float* point = shadingPoints + shadingPointOffset(q);
   StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
                                   MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  PhongParams brdf;
-  brdf.rhoD = point[ROW_RHO_D];
-  brdf.rhoS = point[ROW_RHO_S];
-  brdf.n = point[ROW_N];
-  *partner = cdfInputsOf(brdf, makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
+  *partner = cdfInputsOf(pointBrdf(point), makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
                          makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
   return pairsTables(own, *partner, pixelStageSamples(c) > 0, MA_SHARE_COLUMNS > 0, MA_PIXEL_CELLS);
 }

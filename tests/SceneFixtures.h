@@ -12,6 +12,7 @@
 #include "TestSize.h"
 #include "render/Method.h"
 #include "sampling/HostSampler.h"
+#include "sampling/KernelViews.h"
 #include "sampling/Sampler.h"
 #include "scene/Scene.h"
 #include "scene/Surfaces.h"
@@ -78,6 +79,16 @@ inline void giveRandomFrames(Scene& scene, uint32_t key) {
 inline void giveBackground(Scene& scene, int period) {
   for (size_t p = 1; p < scene.geometry.covered.size(); p += size_t(period)) scene.geometry.covered[p] = 0;
   scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
+}
+
+// Pixel `pixel`'s table inputs in `plan`'s stage of the multi-sample estimator
+// (kernels/pixel_pairs.h), and whether it takes samples there.
+inline std::pair<kern::PixelCdfInputs, bool> stageCdfInputs(const Scene& scene, const StagePlan& plan, int pixel,
+                                                            int product) {
+  const kern::StageCounts c = kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), pixel,
+                                                    plan.techniqueCount, plan.stageSamples, 0, 0, 1);
+  const kern::ShadingPoint sp = makeShadingPoint(scene, pixel);
+  return {kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, product), kern::pixelStageSamples(c) > 0};
 }
 
 // The sampler of the statistical sweeps: the C++ reference, which computes the kernel's

@@ -18,7 +18,6 @@
 #include "TestSize.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
-#include "sampling/KernelViews.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -229,13 +228,8 @@ TEST_CASE("the optimal pdf per pixel is unbiased where pairs of pixels share a t
       scene.grid.pixels[size_t(p)].n = float(kN * 1.03);
     }
     const StagePlan plan = singleStagePlan(scene, Method::Equal, 64);
-    auto inputs = [&](int p) {
-      const kern::StageCounts counts =
-          kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), p, 2, 64, 0, 0, 1);
-      const kern::ShadingPoint sp = makeShadingPoint(scene, p);
-      return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, counts, 0);
-    };
-    REQUIRE(kern::pairsTables(inputs(0), inputs(1), 1, 0, scene.tables.pixelCells));
+    REQUIRE(kern::pairsTables(stageCdfInputs(scene, plan, 0, 0).first, stageCdfInputs(scene, plan, 1, 0).first, 1, 0,
+                              scene.tables.pixelCells));
     const double expected =
         0.5 * (quadratureValue(c.K, kRhoD, kRhoS, kN, even) + quadratureValue(c.K, kRhoD, kRhoS, kN * 1.03, odd));
     for (Estimator e : {Estimator::MultiSample, Estimator::OneSample})

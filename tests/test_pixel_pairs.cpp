@@ -13,7 +13,6 @@
 #include "TestDevice.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
-#include "sampling/KernelViews.h"
 
 using namespace misalloc;
 using namespace misalloc::test;
@@ -171,15 +170,8 @@ TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit
     // Which pairs pair in this plan: some do, some do not.
     int paired = 0, unpaired = 0;
     for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
-      auto inputs = [&](int q) {
-        const kern::StageCounts c =
-            kern::loadStageCounts(plan.counts.data(), plan.firstIndex.data(), q, M, plan.stageSamples, 0, 0, 1);
-        const kern::ShadingPoint sp = makeShadingPoint(scene, q);
-        return std::make_pair(kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, product),
-                              kern::pixelStageSamples(c) > 0);
-      };
-      const auto [a, aSamples] = inputs(p);
-      const auto [b, bSamples] = inputs(p + 1);
+      const auto [a, aSamples] = stageCdfInputs(scene, plan, p, product);
+      const auto [b, bSamples] = stageCdfInputs(scene, plan, p + 1, product);
       if (!aSamples || !bSamples) continue;
       (kern::pairsTables(a, b, 1, 0, scene.tables.pixelCells) ? paired : unpaired) += 1;
     }

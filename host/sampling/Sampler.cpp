@@ -204,9 +204,9 @@ Sampler::Sampler(const Device& device, const Scene& scene, const SamplerConfig& 
 }
 
 StageResult Sampler::runPixels(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range) {
-  const bool statistics = plan.keepStatistics && keepsStatistics(config_);
-  return runOrder(plan, seed, firstSlot, range,
-                  pixelLanes(statistics) > 0 ? sampledPixels(plan, range) : coherentPixelOrder(plan, range));
+  return runOrder(
+      plan, seed, firstSlot, range,
+      pixelLanes(storesStatistics(plan)) > 0 ? sampledPixels(plan, range) : coherentPixelOrder(plan, range));
 }
 
 StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range,
@@ -224,7 +224,7 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   queue.enqueueWriteBuffer(firstIndex_, CL_FALSE, firstRow * sizeof(uint32_t), rows * sizeof(uint32_t),
                            plan.firstIndex.data() + firstRow);
   if (!order.empty()) queue.enqueueWriteBuffer(pixelOrder_, CL_FALSE, 0, order.size() * sizeof(int32_t), order.data());
-  const bool statistics = plan.keepStatistics && keepsStatistics(config_);
+  const bool statistics = storesStatistics(plan);
   cl::Kernel& kernel = statistics ? kernel_ : plainKernel_;
   const SceneBuffers& b = *sceneBuffers_;
   const SceneBuffers::Envmap& env = b.envmap(statistics);

@@ -92,8 +92,10 @@ class Sampler : public StageSampler {
   void forgetStages() override;
 
  private:
-  // runPixels over the pixels of `order` (coherentPixelOrder); the other pixels of
-  // `range` take no samples.
+  // Whether `plan`'s stage runs the kernel that keeps the config's statistics.
+  bool storesStatistics(const StagePlan& plan) const { return plan.keepStatistics && keepsStatistics(config_); }
+  // runPixels over the pixels of `order` (sampledPixels or coherentPixelOrder); the
+  // other pixels of `range` take no samples.
   StageResult runOrder(const StagePlan& plan, uint64_t seed, int firstSlot, PixelRange range,
                        const std::vector<int32_t>& order);
   // The plan's optimal-weight coefficients of `range` (zeros where it has none) into
