@@ -77,21 +77,19 @@ kern::StageCounts stageCountsOf(const StagePlan& plan, const SamplerConfig& conf
                                config.estimator == Estimator::CountIndependent, config.risCandidates);
 }
 
-kern::PixelCdfInputs cdfInputsOf(const Scene& scene, const kern::StageCounts& c, int pixel, int product) {
-  const kern::ShadingPoint sp = makeShadingPoint(scene, pixel);
-  return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, product);
+kern::PixelCdfInputs cdfInputsOf(const kern::ShadingPoint& sp, const kern::StageCounts& c,
+                                 const kern::TechniqueSet& ts) {
+  return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, kern::productEnabled(ts.product));
 }
 
-// The inputs of the table that `pixel` samples: its pair's or its own
+// The inputs of the table that `pixel` samples, given its own: its pair's or its own
 // (kernels/pixel_pairs.h), as kernels/sample.cl's pixelPairsTables chooses.
 kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, const SamplerConfig& config, int pixel,
-                                 const kern::TechniqueSet& ts, int cells) {
-  const int product = kern::productEnabled(ts.product);
-  const kern::PixelCdfInputs own = cdfInputsOf(scene, stageCountsOf(plan, config, pixel), pixel, product);
+                                 const kern::PixelCdfInputs& own, const kern::TechniqueSet& ts, int cells) {
   const int q = kern::pairPartner(pixel, scene.grid.width);
   if (q < 0) return own;
   const kern::StageCounts c = stageCountsOf(plan, config, q);
-  const kern::PixelCdfInputs partner = cdfInputsOf(scene, c, q, product);
+  const kern::PixelCdfInputs partner = cdfInputsOf(makeShadingPoint(scene, q), c, ts);
   return kern::pairsTables(own, partner, kern::pixelStageSamples(c) > 0, ts.sharePdfs, cells)
              ? kern::meanTableInputs(own, partner)
              : own;
@@ -153,7 +151,8 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
     std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
-      const kern::PixelCdfInputs in = tableInputs(scene_, plan, config_, pixel, ts, env.pixelCells);
+      const kern::PixelCdfInputs in =
+          tableInputs(scene_, plan, config_, pixel, cdfInputsOf(sp, c, ts), ts, env.pixelCells);
       kern::buildPixelOptimalCdf(tables.blockProbs.data(), env.pixelCells, in.brdf, in.normal, in.mirror,
                                  in.envmapShare, in.brdfCovers, ts.sharePdfs, ts.product.pixelCells, pixelCdf.data(),
                                  1);
