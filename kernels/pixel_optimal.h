@@ -41,8 +41,8 @@
 #include "pixel_layout.h"
 
 // A cell's floats: two frames (CellFrame, host: EnvmapDistribution.cpp, cellFrames),
-// each a mean direction x, y, z and a spread about it as a lobe's exponent (cellLobe):
-// the cell's, its directions weighed by solid angle, where the BRDF technique's mass
+// each a mean direction x, y, z and its directions' spread about it, as cellFrameOf
+// keeps it (cellLobe, cellCosine): the cell's, its directions weighed by solid angle, where the BRDF technique's mass
 // in it lies; and its light's, its texels weighed as its alias table draws them, where
 // f's mass lies (a sun in a cell's corner is there, not at the cell's centre), the
 // cell's own where it holds no light. Then its share of the plain pdf's mass and its
@@ -55,17 +55,21 @@ enum {
   CELL_X,
   CELL_Y,
   CELL_Z,
-  CELL_SPREAD,
+  CELL_VARIANCE,
+  CELL_HALF_WIDTH,
+  CELL_RAMP,
   CELL_LIGHT_X,
   CELL_LIGHT_Y,
   CELL_LIGHT_Z,
-  CELL_LIGHT_SPREAD,
+  CELL_LIGHT_VARIANCE,
+  CELL_LIGHT_HALF_WIDTH,
+  CELL_LIGHT_RAMP,
   CELL_PLAIN,
   CELL_SOLID_ANGLE,
   CELL_PEAK_LIGHT,
   CELL_PEAK_GAP
 };
-#define MA_CELL_FLOATS 12
+#define MA_CELL_FLOATS 16
 // The plain pdf's share of the pixel's tables where no BRDF sample covers what eq. 6
 // leaves out (tableScalesOf): the defensive part.
 #define MA_PIXEL_PLAIN_SHARE 0.0625f
@@ -107,11 +111,25 @@ MA_FN void addToRowFloat(MA_LOCAL int* rows, int stride, int r, float v) {
   setRowFloat(rows, stride, r, rowFloat(rows, stride, r) + v);
 }
 
-// Directions about a mean `centre`, spread as a cos^κ lobe about it, κ = `spread`.
+// Directions about a mean `centre`, with the second moment `variance` about it along
+// their wider axis: 1/κ of a cos^κ lobe as wide (cellLobe). An angle spread uniformly
+// with that variance spans ±halfWidth, halfWidth = √(3 variance), and rampScale is
+// 1/(4 halfWidth) (cellCosine). The three are kept with the cell: taken per cell and
+// pixel, their divisions and root cost 4–6 % of the table's build (docs/results.md,
+// "Quads of pixels share a table").
 typedef struct {
   MaVec3 centre;
-  float spread;
+  float variance, halfWidth, rampScale;
 } CellFrame;
+
+MA_FN CellFrame cellFrameOf(MaVec3 centre, float variance) {
+  CellFrame f;
+  f.centre = centre;
+  f.variance = variance;
+  f.halfWidth = ma_sqrt(3.0f * variance);
+  f.rampScale = f.halfWidth > 0.0f ? 0.25f / f.halfWidth : 0.0f;
+  return f;
+}
 
 typedef struct {
   CellFrame area;   // CELL_X … CELL_SPREAD: p_ρ's mass is taken there
@@ -121,12 +139,14 @@ typedef struct {
 
 MA_FN float cellField(MA_GLOBAL const float* cells, int count, int c, int field) { return cells[field * count + c]; }
 
-// The frame whose fields start at `first` (CELL_X or CELL_LIGHT_X).
+// The frame whose fields start at `first` (CELL_X or CELL_LIGHT_X), in CellFrame's order.
 MA_FN CellFrame cellFrameAt(MA_GLOBAL const float* cells, int count, int c, int first) {
   CellFrame f;
   f.centre = makeVec3(cellField(cells, count, c, first), cellField(cells, count, c, first + 1),
                       cellField(cells, count, c, first + 2));
-  f.spread = cellField(cells, count, c, first + 3);
+  f.variance = cellField(cells, count, c, first + 3);
+  f.halfWidth = cellField(cells, count, c, first + 4);
+  f.rampScale = cellField(cells, count, c, first + 5);
   return f;
 }
 
@@ -142,24 +162,25 @@ MA_FN PixelCell pixelCellAt(MA_GLOBAL const float* cells, int count, int c) {
 // The Phong lobe averaged over a frame's directions rather than taken at its centre: a
 // lobe narrower than a cell would otherwise weigh the cell by its tail at the centre,
 // and a glossy pixel's table would miss the cell that holds its lobe. cos^κ spreads a
-// direction by 1/κ per axis; a frame's κ is the inverse of its directions' second
-// moment about their mean along their wider axis (a cell at a pole is a narrow wedge),
-// so that cos^n about the mirror direction spread by the frame is cos^κ' with
-// 1/κ' = 1/n + 1/κ (variances add), scaled by (κ'+1)/(n+1) so that the lobe keeps its
-// mass 2π/(n+1).
+// direction by 1/κ per axis, and a frame's directions by its variance (a cell at a pole
+// is a narrow wedge: the wider axis's), so that cos^n about the mirror direction spread
+// by the frame is cos^κ' with 1/κ' = 1/n + variance (variances add),
+// κ' = n/(1 + n variance), scaled by (κ'+1)/(n+1) so that the lobe keeps its mass
+// 2π/(n+1). 1/(n+1) is the pixel's, out of the loops over cells.
 MA_FN float cellLobe(PhongParams b, CellFrame frame, MaVec3 mirror) {
   PhongParams spread = b;
-  spread.n = b.n / (1.0f + b.n / frame.spread);
-  return (spread.n + 1.0f) / (b.n + 1.0f) * phongLobe(spread, frame.centre, mirror);
+  spread.n = b.n / ma_fma(b.n, frame.variance, 1.0f);
+  return (spread.n + 1.0f) * (1.0f / (b.n + 1.0f)) * phongLobe(spread, frame.centre, mirror);
 }
 
 // max(0, cos θ) averaged over a frame's directions rather than taken at its centre, so
 // that a cell that straddles the horizon keeps the part above it: the angle above the
-// horizon spread uniformly by ±w about the centre's, w = √(3/κ) (the frame's spread), in
-// its small-angle form: the centre's value where the frame lies wholly above, 0 below.
+// horizon spread uniformly by ±w about the centre's (w the frame's halfWidth), in its
+// small-angle form, (c + w)²/(4w): the centre's value where the frame lies wholly
+// above, 0 below.
 MA_FN float cellCosine(MaVec3 normal, CellFrame frame) {
-  float c = dot3(normal, frame.centre), w = ma_sqrt(3.0f / frame.spread);
-  float straddling = (c + w) * (c + w) / (4.0f * w);
+  float c = dot3(normal, frame.centre), w = frame.halfWidth;
+  float straddling = (c + w) * (c + w) * frame.rampScale;
   return c >= w ? c : c > -w ? straddling : 0.0f;
 }
 

@@ -1,14 +1,17 @@
 // Pixels x = 2k and 2k + 1 of a row sample one per-pixel table where their tables
 // would be alike (kernels/pixel_optimal.h): built from the mean of their inputs, it
-// costs half a build each. Neighbours on a smooth surface differ by a fraction of a
-// cell; the table cannot tell them apart much better than that. Any table with the
-// coverage rule keeps the estimator unbiased, and the pair's keeps it: both pixels draw
-// BRDF samples (which cover their own f), or neither does (the table's plain share
-// covers every lit texel). The pair is fixed by the pixels' places in their row, so a
-// pixel's table does not depend on the launch that samples it: its work-group, its
-// device's tiles, its band (whole rows: render/Band.h). A stage that stores share
-// columns (kernels/stats.h) keeps each pixel's own table: its samples carry pdfs
-// recomputed from the pixel's own inputs.
+// costs half a build each. Pixels x = 4k … 4k + 3, a quad, sample one where each of its
+// pairs would, and the pairs' means are alike too: a quarter of a build each, where the
+// surface is flat or smooth at the pixels' scale (a plane, most of a mesh), not where it
+// curves within a cell's width in four pixels (a small sphere). Neighbours on a smooth
+// surface differ by a fraction of a cell; the table cannot tell them apart much better
+// than that. Any table with the coverage rule keeps the estimator unbiased, and these
+// keep it: all their pixels draw BRDF samples (which cover their own f), or none does
+// (the table's plain share covers every lit texel). The pixels that share a table are
+// fixed by their places in their row, so a pixel's table does not depend on the launch
+// that samples it: its work-group, its device's tiles, its band (whole rows:
+// render/Band.h). A stage that stores share columns (kernels/stats.h) keeps each pixel's
+// own table: its samples carry pdfs recomputed from the pixel's own inputs.
 #include "namespace_check.h"
 #ifndef MA_PIXEL_PAIRS_H
 #define MA_PIXEL_PAIRS_H
@@ -32,13 +35,6 @@ MA_FN PixelCdfInputs cdfInputsOf(PhongParams brdf, MaVec3 normal, MaVec3 mirror,
   in.envmapShare = stageEnvmapShare(product, c);
   in.brdfCovers = stageDrawsBrdf(c);
   return in;
-}
-
-// The other pixel of `pixel`'s pair, in an image `width` pixels wide; −1 for the last
-// pixel of a row of odd width.
-MA_FN int pairPartner(int pixel, int width) {
-  int x = pixel % width, other = x ^ 1;
-  return other < width ? pixel - x + other : -1;
 }
 
 // Within 5 % of their mean.
@@ -80,12 +76,48 @@ MA_FN PixelCdfInputs meanTableInputs(PixelCdfInputs a, PixelCdfInputs b) {
   return m;
 }
 
-// Whether a pixel samples its pair's table (meanTableInputs), given its own inputs and
-// its partner's (pairPartner), which takes samples in the stage or not
-// (partnerSamples), in a stage that stores share columns or not. Both pixels of a pair
-// answer alike.
-MA_FN int pairsTables(PixelCdfInputs own, PixelCdfInputs partner, int partnerSamples, int shareColumns, int cells) {
-  return !shareColumns && partnerSamples && alikeTableInputs(own, partner, cells);
+// The pixels that sample one table: `size` (1, 2 or 4) of a row from `first`, and the
+// inputs it is built from.
+typedef struct {
+  int first, size;
+  PixelCdfInputs inputs;
+} TableGroup;
+
+// The first place of `x`'s quad in a row `width` pixels wide, and how many of its four
+// places the row holds.
+MA_FN int quadFirst(int x) { return x & ~3; }
+MA_FN int quadPlaces(int x, int width) { return width - quadFirst(x) < 4 ? width - quadFirst(x) : 4; }
+
+// The table that `pixel`, at place x of a row `width` wide, samples, given the inputs of
+// the pixels of its quad the row holds (quad[i] at place quadFirst(x) + i) and whether
+// each takes samples in the stage: the quad's, its pair's or its own, in a stage that
+// stores share columns or not. Every pixel of a quad answers alike from the same inputs,
+// and each mean's sums are the same whichever pixel adds them, so all build the same
+// table, bit for bit.
+MA_FN TableGroup tableGroupOf(int pixel, int x, int width, const PixelCdfInputs* quad, const int* samples,
+                              int shareColumns, int cells) {
+  int i = x - quadFirst(x), j = i ^ 1, places = quadPlaces(x, width);
+  TableGroup g;
+  g.first = pixel;
+  g.size = 1;
+  g.inputs = quad[i];
+  if (shareColumns) return g;
+  if (places == 4 && samples[0] && samples[1] && samples[2] && samples[3] &&
+      alikeTableInputs(quad[0], quad[1], cells) && alikeTableInputs(quad[2], quad[3], cells)) {
+    PixelCdfInputs low = meanTableInputs(quad[0], quad[1]), high = meanTableInputs(quad[2], quad[3]);
+    if (alikeTableInputs(low, high, cells)) {
+      g.first = pixel - i;
+      g.size = 4;
+      g.inputs = meanTableInputs(low, high);
+      return g;
+    }
+  }
+  if (j < places && samples[j] && alikeTableInputs(quad[i], quad[j], cells)) {
+    g.first = pixel - (i & 1);
+    g.size = 2;
+    g.inputs = meanTableInputs(quad[i], quad[j]);
+  }
+  return g;
 }
 
 #endif

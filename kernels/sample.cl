@@ -120,24 +120,25 @@ MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride,
 #undef ROW_FLOAT
 }
 
-// Whether `pixel` samples its pair's table (kernels/pixel_pairs.h), given its own
-// inputs: its partner's are read from global memory, where their stage writes them.
-MA_FN int pixelPairsTables(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
-                           __global const uint* firstIndex, int stageSamples, int pixel, int imageWidth,
-                           PixelCdfInputs* partner) {
-  int q = pairPartner(pixel, imageWidth);
-  if (q < 0) return 0;
-  __global const float* point = shadingPoints + shadingPointOffset(q);
-  StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
-                                  MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-  *partner = cdfInputsOf(pointBrdf(point), makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
-                         makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
-  return pairsTables(own, *partner, pixelStageSamples(c) > 0, MA_SHARE_COLUMNS > 0, MA_PIXEL_CELLS);
-}
-
-// The inputs of the table that `pixel` samples: its pair's or its own.
-MA_FN PixelCdfInputs tableInputs(PixelCdfInputs own, int paired, PixelCdfInputs partner) {
-  return paired ? meanTableInputs(own, partner) : own;
+// The table that `pixel` samples (kernels/pixel_pairs.h, tableGroupOf), given its own
+// inputs: the others of its quad are read from global memory, where their stage writes
+// them.
+MA_FN TableGroup pixelTableGroup(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
+                                 __global const uint* firstIndex, int stageSamples, int pixel, int imageWidth) {
+  int x = pixel % imageWidth, first = pixel - x + quadFirst(x), places = quadPlaces(x, imageWidth);
+  PixelCdfInputs quad[4];
+  int samples[4];
+  for (int i = 0; i < 4; ++i) {
+    int q = first + (i < places ? i : 0);
+    __global const float* point = shadingPoints + shadingPointOffset(q);
+    StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                    MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
+    quad[i] = q == pixel ? own
+                         : cdfInputsOf(pointBrdf(point), makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
+                                       makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
+    samples[i] = pixelStageSamples(c) > 0;
+  }
+  return tableGroupOf(pixel, x, imageWidth, quad, samples, MA_SHARE_COLUMNS > 0, MA_PIXEL_CELLS);
 }
 
 // The one-sample estimator's pass: the stage's samples, none for the background
@@ -281,10 +282,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 #if MA_PIXEL_CELLS > 0
   // The background takes no samples and needs no table.
   if (oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid) > 0) {
-    PixelCdfInputs own = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples), partner;
-    int paired =
-        pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth, &partner);
-    PixelCdfInputs in = tableInputs(own, paired, partner);
+    PixelCdfInputs own = pixelCdfInputs(pixelRows, MA_LOCAL_SIZE, lid, stageSamples);
+    PixelCdfInputs in =
+        pixelTableGroup(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth).inputs;
     buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                          MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
                          MA_LOCAL_SIZE);
@@ -358,8 +358,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
 // The same stage on a CPU, a work-group of L = MA_PIXEL_LANES lanes (the float vector
 // width) for P = MA_GROUP_PIXELS ≤ L pixels (L, or fewer where their tables would not
 // fit local memory: host/sampling/Sampler.h, pixelStageGroupPixels). First lane l
-// builds pixel l's table (the C++ reference's buildPixelOptimalCdf), unless lane l − 1
-// builds the table that it samples (kernels/pixel_pairs.h): the lanes read
+// builds pixel l's table (the C++ reference's buildPixelOptimalCdf), unless a lane
+// before it builds the table that it samples (its pair's or quad's,
+// kernels/pixel_pairs.h): the lanes read
 // each cell at one address, and PoCL vectorises the build's first pass across cells.
 // Then the lanes sample the pixels one at a time: lane l takes samples l, L + l,
 // 2L + l, ... of each technique, so that PoCL vectorises across a pixel's samples.
@@ -424,8 +425,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
   int pixels = min(MA_GROUP_PIXELS, pixelCount - first);
   // Lane l loads pixel l of the work-group and builds its table as the C++ reference
   // does: the lanes build their tables side by side, each reading the cells at the same
-  // addresses. A pixel whose pair's table the lane before builds (its partner, sorted
-  // next to it by its counts) samples that table instead.
+  // addresses. A pixel whose pair's or quad's table a lane before builds (the pixels
+  // that take samples, in index order: sampledPixels) samples that table instead.
   __local int tableLane[MA_GROUP_PIXELS];
   if (lid < pixels) {
     int pixel = pixelOrder[first + lid];
@@ -433,10 +434,13 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
                   productWords, stageSamples, pixel);
     int lane = lid;
 #if MA_PIXEL_CELLS > 0
-    PixelCdfInputs own = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples), partner;
-    int paired = pixelPairsTables(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth, &partner);
-    if (paired && lid > 0 && pixelOrder[first + lid - 1] == pairPartner(pixel, imageWidth)) lane = lid - 1;
-    PixelCdfInputs in = tableInputs(own, paired, partner);
+    PixelCdfInputs own = pixelCdfInputs(groupRows, 1, lid * ROW_BLOCK, stageSamples);
+    TableGroup group = pixelTableGroup(own, shadingPoints, counts, firstIndex, stageSamples, pixel, imageWidth);
+    // The group's pixels that take samples lie in adjacent lanes, in index order: the
+    // first of them in this work-group builds.
+    for (int back = 1; back < 4; ++back)
+      if (lid >= back && pixelOrder[first + lid - back] >= group.first) lane = lid - back;
+    PixelCdfInputs in = group.inputs;
     if (lane == lid)
       buildPixelOptimalCdf(blockProbs, MA_PIXEL_CELLS, in.brdf, in.normal, in.mirror, in.envmapShare, in.brdfCovers,
                            MA_SHARE_COLUMNS > 0, MA_PRODUCT_CELLS, groupRows + lid * ROW_BLOCK + ROW_PIXEL_CDF, 1);

@@ -110,9 +110,9 @@ TEST_CASE("merged bands are the unsharded render bit for bit, for every method",
 }
 
 TEST_CASE("bands of an odd width merge bit for bit where pairs of pixels share a table", "[band][cli][pairs]") {
-  // A uniform plane with the optimal pdf per pixel: every pair of a row shares a table
+  // A uniform plane with the optimal pdf per pixel: every quad of a row shares a table
   // (kernels/pixel_pairs.h). 15 pixels wide with a halo of one row, the bands start on
-  // odd pixels: pairs taken by index instead of by their place in the row differ
+  // odd pixels: quads taken by index instead of by their place in the row differ
   // there, and the halo's pilot reaches the band's first row through the pooling.
   TempDir dir("band-pairs");
   const std::string scene =

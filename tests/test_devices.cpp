@@ -132,10 +132,10 @@ TEST_CASE("two devices render the image of one, bit for bit, with every method",
 }
 
 TEST_CASE("two devices render the image of one where pairs of pixels cross a tile's edge", "[devices][pairs]") {
-  // 15 pixels wide: the tiles of 16 pixels cut rows, so a pair of pixels that shares a
-  // table (kernels/pixel_pairs.h) can lie in two tiles, and a device reads the counts
-  // of its tile's neighbour. Exponents 1.3 % apart across the plane: every pair of a row
-  // shares, and its table is neither pixel's own.
+  // 15 pixels wide: the tiles of 16 pixels cut rows, so a pair or quad of pixels that
+  // shares a table (kernels/pixel_pairs.h) can lie in two tiles, and a device reads the
+  // counts of up to three pixels of its tile's neighbour. Exponents 1.3 % apart across
+  // the plane: every quad of a row shares, and its table is no pixel's own.
   const Scene scene =
       smallScene("sun", "general:0.3,0.3,50,60", 15, 26, false, EnvmapSampler::Alias, 0, "optimal-pixel");
   SamplerDevices one("cpu"), two(twoCpuDevices());

@@ -210,11 +210,11 @@ TEST_CASE("the optimal pdf per pixel is unbiased in frames off the map's axis, a
   checkFamily(family);
 }
 
-TEST_CASE("the optimal pdf per pixel is unbiased where pairs of pixels share a table, against a quadrature",
+TEST_CASE("the optimal pdf per pixel is unbiased where quads of pixels share a table, against a quadrature",
           "[geometry][unbiased][optimal][pairs]") {
   // Pixel 2k + 1's normal is pixel 2k's turned by 1.5° and its exponent 3 % larger: each
-  // pair samples the table of their mean inputs (kernels/pixel_pairs.h), which is
-  // neither pixel's own. The image's mean is the mean of both frames' quadratures.
+  // quad samples the table of its mean inputs (kernels/pixel_pairs.h), which is neither
+  // pixel's own. The image's mean is the mean of both frames' quadratures.
   BiasFamily family(0.02);
   uint64_t seed = 3200;
   for (const OffAxisCase& c : offAxisCases()) {
@@ -228,12 +228,17 @@ TEST_CASE("the optimal pdf per pixel is unbiased where pairs of pixels share a t
       scene.grid.pixels[size_t(p)].n = float(kN * 1.03);
     }
     const StagePlan plan = singleStagePlan(scene, Method::Equal, 64);
-    REQUIRE(kern::pairsTables(stageCdfInputs(scene, plan, 0, 0).first, stageCdfInputs(scene, plan, 1, 0).first, 1, 0,
-                              scene.tables.pixelCells));
+    // Pixels 0 … 3 alternate the two frames: the pairs alike, and their means the same.
+    REQUIRE(scene.grid.width >= 4);
+    std::vector<kern::PixelCdfInputs> quad;
+    for (int p = 0; p < 4; ++p) quad.push_back(stageCdfInputs(scene, plan, p, 0).first);
+    const std::vector<int> samples(4, 1);
+    REQUIRE(kern::tableGroupOf(0, 0, scene.grid.width, quad.data(), samples.data(), 0, scene.tables.pixelCells).size ==
+            4);
     const double expected =
         0.5 * (quadratureValue(c.K, kRhoD, kRhoS, kN, even) + quadratureValue(c.K, kRhoD, kRhoS, kN * 1.03, odd));
     for (Estimator e : {Estimator::MultiSample, Estimator::OneSample})
-      addSized(family, fmt::format("{}, pairs: equal estimator {}", offAxisName(c), int(e)), expected, 64, 4, ++seed,
+      addSized(family, fmt::format("{}, quads: equal estimator {}", offAxisName(c), int(e)), expected, 64, 4, ++seed,
                [&](int spp, uint64_t sd) { return renderMean(scene, Method::Equal, e, spp, sd); });
   }
   checkFamily(family);

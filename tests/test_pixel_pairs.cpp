@@ -1,6 +1,6 @@
-// Pairs of pixels that sample one per-pixel table (kernels/pixel_pairs.h): when they
-// pair, that both build the same table, that the kernels pair them as the C++ reference
-// does, and that the estimate stays unbiased.
+// Pairs and quads of pixels that sample one per-pixel table (kernels/pixel_pairs.h): when
+// they share, that all build the same table, that the kernels group them as the C++
+// reference does, and that the estimate stays unbiased.
 #include <fmt/format.h>
 
 #include <catch2/catch.hpp>
@@ -46,8 +46,16 @@ kern::PixelCdfInputs glossyInputs() {
   return in;
 }
 
-bool pairs(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
-  return kern::pairsTables(a, b, 1, 0, kCells);
+// The table pixel x samples in a row `width` wide whose pixels x & ~3 … have `quad`'s
+// inputs and take samples or not.
+kern::TableGroup groupOf(int x, int width, const std::vector<kern::PixelCdfInputs>& quad,
+                         const std::vector<int>& samples, int shareColumns = 0) {
+  return kern::tableGroupOf(100 + x, x, width, quad.data(), samples.data(), shareColumns, kCells);
+}
+
+// Pixels a and b, places 0 and 1 of a row of two, where b takes samples or not.
+bool pairs(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b, int bSamples = 1, int shareColumns = 0) {
+  return groupOf(0, 2, {a, b, a, a}, {1, bSamples, 0, 0}, shareColumns).size == 2;
 }
 
 bool sameBits(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
@@ -64,8 +72,8 @@ TEST_CASE("two pixels share a table only where their inputs are alike", "[pairs]
   const kern::PixelCdfInputs a = glossyInputs();
   CHECK(pairs(a, a));
   // Neither the stage's share columns nor a partner without samples.
-  CHECK_FALSE(kern::pairsTables(a, a, 0, 0, kCells));
-  CHECK_FALSE(kern::pairsTables(a, a, 1, 1, kCells));
+  CHECK_FALSE(pairs(a, a, 0));
+  CHECK_FALSE(pairs(a, a, 1, 1));
   // One draws BRDF samples and the other none: the table's plain share differs, and
   // without it the second's texels that eq. 6 clips could not be drawn.
   kern::PixelCdfInputs b = a;
@@ -125,21 +133,78 @@ TEST_CASE("both pixels of a pair build the same table", "[pairs]") {
   CHECK(paired < 380);
 }
 
+TEST_CASE("four pixels share a table where both pairs and their means are alike", "[pairs]") {
+  const kern::PixelCdfInputs a = glossyInputs();
+  auto at = [&](double degrees) {
+    kern::PixelCdfInputs b = a;
+    b.normal = turned(a.normal, degrees);
+    return b;
+  };
+  // Normals at 0°, 1°, 1.5°, 2.5° along one arc: pairs 1° apart, their means 1.5°.
+  const std::vector<kern::PixelCdfInputs> quad = {a, at(1), at(1.5), at(2.5)};
+  const std::vector<int> all = {1, 1, 1, 1};
+  const kern::TableGroup g = groupOf(0, 8, quad, all);
+  CHECK(g.first == 100);
+  CHECK(g.size == 4);
+  CHECK(sameBits(g.inputs,
+                 kern::meanTableInputs(kern::meanTableInputs(quad[0], quad[1]), kern::meanTableInputs(quad[2], quad[3]))));
+  // Every pixel of the quad samples the same table, bit for bit, from its own place.
+  for (int x = 1; x < 4; ++x) {
+    const kern::TableGroup other = groupOf(x, 8, quad, all);
+    CHECK(other.first == 100);
+    CHECK(other.size == 4);
+    CHECK(sameBits(other.inputs, g.inputs));
+  }
+  // At 0°, 1°, 3°, 4° the pairs' means lie 3° apart, past Δ/4 = 2.81°: two pairs.
+  const std::vector<kern::PixelCdfInputs> apart = {a, at(1), at(3), at(4)};
+  for (int x = 0; x < 4; ++x) {
+    const kern::TableGroup pair = groupOf(x, 8, apart, all);
+    CHECK(pair.size == 2);
+    CHECK(pair.first == 100 + (x & ~1));
+    CHECK(sameBits(pair.inputs, kern::meanTableInputs(apart[size_t(x & ~1)], apart[size_t(x | 1)])));
+  }
+  // A pixel of the quad that takes no samples leaves its partner alone and the other pair.
+  const std::vector<int> third = {1, 1, 0, 1};
+  CHECK(groupOf(0, 8, quad, third).size == 2);
+  CHECK(groupOf(3, 8, quad, third).size == 1);
+  // A row that ends within the quad (6 wide: places 4 and 5) pairs them at most.
+  CHECK(groupOf(4, 6, quad, all).size == 2);
+  CHECK(groupOf(5, 6, quad, all).first == 104);
+  CHECK(groupOf(4, 5, quad, all).size == 1);
+  // A stage that stores share columns keeps each pixel's own.
+  CHECK(groupOf(2, 8, quad, all, 1).size == 1);
+}
+
 namespace {
 
-// A scene whose even pixels have random frames and whose pixel 2k + 1 is pixel 2k turned
-// by a little (they pair) or by too much (every third pair), with an exponent 3 % apart.
+// Whether quad q of pairedScene shares one table where its counts allow.
+bool alikeQuad(int q) { return q % 3 == 0; }
+
+// A scene of random frames in which pixel 2k + 1 is pixel 2k turned by a little (they
+// pair) or by too much (every third pair), with an exponent 3 % apart; and in every
+// third quad, pixels 1, 2 and 3 are pixel 0 turned by 1°, 1.5° and 2.5° (the quad
+// shares), their exponents 1 % apart.
 Scene pairedScene(const std::string& map, int width, int height, bool product) {
   Scene scene =
       smallScene(map, "uniform:0.3,0.6,200", width, height, false, EnvmapSampler::Alias, 0, "optimal-pixel", product);
   giveRandomFrames(scene, 11);
-  for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
-    const PixelFrame& f = scene.geometry.pixels[size_t(p)];
-    const double degrees = (p / 2) % 3 == 2 ? 6.0 : 1.0;
+  auto turn = [&](int from, int to, double degrees, float exponent) {
+    const PixelFrame& f = scene.geometry.pixels[size_t(from)];
     const kern::MaVec3 n = turned(kern::makeVec3(f.normal[0], f.normal[1], f.normal[2]), degrees);
     const kern::MaVec3 m = turned(kern::makeVec3(f.mirror[0], f.mirror[1], f.mirror[2]), degrees);
-    scene.geometry.pixels[size_t(p) + 1] = {{n.x, n.y, n.z}, {m.x, m.y, m.z}};
-    scene.grid.pixels[size_t(p) + 1].n *= 1.03f;
+    scene.geometry.pixels[size_t(to)] = {{n.x, n.y, n.z}, {m.x, m.y, m.z}};
+    scene.grid.pixels[size_t(to)].n = scene.grid.pixels[size_t(from)].n * exponent;
+  };
+  for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
+    const int x = p % width, quad = p / 4;
+    if (alikeQuad(quad) && x % 4 == 0 && x + 3 < width) {
+      turn(p, p + 1, 1.0, 1.01f);
+      turn(p, p + 2, 1.5, 1.02f);
+      turn(p, p + 3, 2.5, 1.03f);
+      p += 2;
+    } else {
+      turn(p, p + 1, (p / 2) % 3 == 2 ? 6.0 : 1.0, 1.03f);
+    }
   }
   scene.surfaces = labelSurfaces(scene.geometry, scene.grid);
   return scene;
@@ -158,7 +223,8 @@ TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit
     const int M = plan.techniqueCount;
     for (int p = 0; p < scene.pixelCount(); ++p) {
       int32_t* n = plan.counts.data() + size_t(p) * M;
-      const int pair = p / 2, product = M == 3 ? 5 : 0;
+      // A quad that may share takes its first pair's counts.
+      const int pair = alikeQuad(p / 4) ? p / 4 * 2 : p / 2, product = M == 3 ? 5 : 0;
       n[0] = 10 + (pair * 7) % 20 + (pair % 5 == 4 ? p % 2 : 0);
       // Every seventh pair: one pixel draws no BRDF samples, the other two, at envmap
       // shares 1/16 apart.
@@ -167,16 +233,23 @@ TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit
       if (M == 3) n[2] = product;
     }
     leaveOutBackground(scene, plan.counts);
-    // Which pairs pair in this plan: some do, some do not.
-    int paired = 0, unpaired = 0;
-    for (int p = 0; p + 1 < scene.pixelCount(); p += 2) {
-      const auto [a, aSamples] = stageCdfInputs(scene, plan, p, product);
-      const auto [b, bSamples] = stageCdfInputs(scene, plan, p + 1, product);
-      if (!aSamples || !bSamples) continue;
-      (kern::pairsTables(a, b, 1, 0, scene.tables.pixelCells) ? paired : unpaired) += 1;
+    // How the pixels that take samples share tables in this plan: in quads, in pairs and
+    // alone, each more than a few times.
+    int groups[5] = {0, 0, 0, 0, 0};
+    const int width = scene.grid.width;
+    for (int p = 0; p < scene.pixelCount(); ++p) {
+      const int x = p % width, first = p - x + kern::quadFirst(x);
+      std::vector<kern::PixelCdfInputs> quad(4);
+      std::vector<int> samples(4, 0);
+      for (int i = 0; i < kern::quadPlaces(x, width); ++i)
+        std::tie(quad[size_t(i)], samples[size_t(i)]) = stageCdfInputs(scene, plan, first + i, product);
+      if (samples[size_t(x - kern::quadFirst(x))])
+        ++groups[kern::tableGroupOf(p, x, width, quad.data(), samples.data(), 0, scene.tables.pixelCells).size];
     }
-    CHECK(paired > 10);
-    CHECK(unpaired > 10);
+    INFO("alone " << groups[1] << ", in pairs " << groups[2] << ", in quads " << groups[4]);
+    CHECK(groups[1] > 10);
+    CHECK(groups[2] > 10);
+    CHECK(groups[4] > 10);
     const SamplerConfig config{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 0};
     Sampler device(testDevice(), scene, config);
     HostSampler host(scene, config);

@@ -372,10 +372,9 @@ namespace {
 
 // Per cell of 2^log2 texels a side, its frame (kernels/pixel_optimal.h, CellFrame) under
 // the texels' weights `weightOf(row, col, sin θ)`: the weighed mean of their directions, and
-// the exponent κ = 1/σ² of a cos^κ lobe as wide as they are along their wider axis (σ²
-// the larger eigenvalue of their weighed second moment in the plane tangent to the
-// mean), a texel's own extent (its θ-side²/12) added. A cell whose texels all weigh 0
-// gets no frame (spread 0).
+// their variance σ² along their wider axis (the larger eigenvalue of their weighed second
+// moment in the plane tangent to the mean), a texel's own extent (its θ-side²/12) added.
+// A cell whose texels all weigh 0 gets no frame (variance 0).
 template <typename WeightOf>
 std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightOf weightOf) {
   const int side = 1 << log2, across = (width + side - 1) / side, down = (height + side - 1) / side;
@@ -402,7 +401,7 @@ std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightO
   forEachTexel([&](std::size_t c, double w, double x, double y, double z) {
     sum[c][0] += w * x, sum[c][1] += w * y, sum[c][2] += w * z, sum[c][3] += w;
   });
-  std::vector<kern::CellFrame> frames(cells, kern::CellFrame{kern::makeVec3(0.0f, 0.0f, 1.0f), 0.0f});
+  std::vector<kern::CellFrame> frames(cells, kern::cellFrameOf(kern::makeVec3(0.0f, 0.0f, 1.0f), 0.0f));
   std::vector<kern::MaFrame> tangents(cells);  // t and s span the plane tangent to the mean
   for (std::size_t c = 0; c < cells; ++c) {
     const double r = std::sqrt(sum[c][0] * sum[c][0] + sum[c][1] * sum[c][1] + sum[c][2] * sum[c][2]);
@@ -421,7 +420,7 @@ std::vector<kern::CellFrame> cellFrames(int width, int height, int log2, WeightO
     if (!(sum[c][3] > 0)) continue;
     const double uu = moment[c][0] / sum[c][3], uv = moment[c][1] / sum[c][3], vv = moment[c][2] / sum[c][3];
     const double wider = 0.5 * (uu + vv) + std::sqrt(0.25 * (uu - vv) * (uu - vv) + uv * uv);
-    frames[c].spread = float(1 / (wider + texelExtent));
+    frames[c] = kern::cellFrameOf(frames[c].centre, float(wider + texelExtent));
   }
   return frames;
 }
@@ -506,7 +505,9 @@ EnvmapTables buildPixelOptimalEnvmapTables(const Envmap& envmap, int cellsAcross
       field(first) = frame.centre.x;
       field(first + 1) = frame.centre.y;
       field(first + 2) = frame.centre.z;
-      field(first + 3) = frame.spread;
+      field(first + 3) = frame.variance;
+      field(first + 4) = frame.halfWidth;
+      field(first + 5) = frame.rampScale;
     };
     store(kern::CELL_X, area[std::size_t(cell)]);
     store(kern::CELL_LIGHT_X, light[std::size_t(cell)]);

@@ -82,17 +82,19 @@ kern::PixelCdfInputs cdfInputsOf(const kern::ShadingPoint& sp, const kern::Stage
   return kern::cdfInputsOf(sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, c, kern::productEnabled(ts.product));
 }
 
-// The inputs of the table that `pixel` samples, given its own: its pair's or its own
-// (kernels/pixel_pairs.h), as kernels/sample.cl's pixelPairsTables chooses.
+// The inputs of the table that `pixel` samples, given its own: its quad's, its pair's or
+// its own (kernels/pixel_pairs.h), as kernels/sample.cl's pixelTableGroup chooses.
 kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, const SamplerConfig& config, int pixel,
                                  const kern::PixelCdfInputs& own, const kern::TechniqueSet& ts, int cells) {
-  const int q = kern::pairPartner(pixel, scene.grid.width);
-  if (q < 0) return own;
-  const kern::StageCounts c = stageCountsOf(plan, config, q);
-  const kern::PixelCdfInputs partner = cdfInputsOf(makeShadingPoint(scene, q), c, ts);
-  return kern::pairsTables(own, partner, kern::pixelStageSamples(c) > 0, ts.sharePdfs, cells)
-             ? kern::meanTableInputs(own, partner)
-             : own;
+  const int width = scene.grid.width, x = pixel % width, first = pixel - x + kern::quadFirst(x);
+  kern::PixelCdfInputs quad[4];
+  int samples[4] = {0, 0, 0, 0};
+  for (int i = 0; i < kern::quadPlaces(x, width); ++i) {
+    const kern::StageCounts c = stageCountsOf(plan, config, first + i);
+    quad[i] = first + i == pixel ? own : cdfInputsOf(makeShadingPoint(scene, first + i), c, ts);
+    samples[i] = kern::pixelStageSamples(c) > 0;
+  }
+  return kern::tableGroupOf(pixel, x, width, quad, samples, ts.sharePdfs, cells).inputs;
 }
 
 }  // namespace

@@ -10,8 +10,8 @@ namespace misalloc {
 
 // The pixels of `range` that take samples this stage, in index order: samplePixelStage's
 // (kernels/sample.cl), whose lanes sample one pixel at a time, so that like counts gain
-// nothing, and a pair of pixels that samples one table (kernels/pixel_pairs.h) lies side
-// by side, where one lane builds it for both.
+// nothing, and the pixels of a pair or quad that sample one table (kernels/pixel_pairs.h)
+// lie side by side, where one lane builds it for all.
 std::vector<int32_t> sampledPixels(const StagePlan& plan, PixelRange range);
 
 // The order in which sampleStage's work-items take the pixels of `range`. A work-group runs each

@@ -214,9 +214,10 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
   const int M = scene_.techniqueCount();
   StageResult result;
   if (range.size() == 0) return result;
-  // With the pixels' counts beside the range, where a pair across its edge reads its
-  // partner's (kernels/pixel_pairs.h): a tile of 16 pixels need not start a row.
-  const PixelRange written{std::max(0, range.begin - 1), std::min(scene_.pixelCount(), range.end + 1)};
+  // With the counts of the three pixels each side of the range, where a pair or quad
+  // across its edge reads the others' (kernels/pixel_pairs.h): a tile of 16 pixels need
+  // not start a row.
+  const PixelRange written{std::max(0, range.begin - 3), std::min(scene_.pixelCount(), range.end + 3)};
   const size_t rows = kern::countsOffset(written.size(), M), firstRow = kern::countsOffset(written.begin, M);
   const cl::CommandQueue& queue = device_.queue;
   queue.enqueueWriteBuffer(counts_, CL_FALSE, firstRow * sizeof(int32_t), rows * sizeof(int32_t),
