@@ -83,40 +83,59 @@ typedef struct {
   PixelCdfInputs inputs;
 } TableGroup;
 
-// The first place of `x`'s quad in a row `width` pixels wide, and how many of its four
-// places the row holds.
+// A pair's table, the mean of its inputs, and whether it serves both: both take samples
+// and their inputs are alike.
+typedef struct {
+  PixelCdfInputs mean;
+  int shares;
+} PairTable;
+
+MA_FN PairTable pairTableOf(PixelCdfInputs a, PixelCdfInputs b, int bothSample, int cells) {
+  PairTable t;
+  t.mean = meanTableInputs(a, b);
+  t.shares = bothSample && alikeTableInputs(a, b, cells);
+  return t;
+}
+
+// Places in a row: the first of x's quad, how many of the quad's four places a row
+// `width` wide holds, x's partner in its pair, and the first of the quad's other pair.
 MA_FN int quadFirst(int x) { return x & ~3; }
 MA_FN int quadPlaces(int x, int width) { return width - quadFirst(x) < 4 ? width - quadFirst(x) : 4; }
+MA_FN int pairPartner(int x) { return x ^ 1; }
+MA_FN int otherPairFirst(int x) { return quadFirst(x) + ((x & 2) ^ 2); }
 
-// The table that `pixel`, at place x of a row `width` wide, samples, given the inputs of
-// the pixels of its quad the row holds (quad[i] at place quadFirst(x) + i) and whether
-// each takes samples in the stage: the quad's, its pair's or its own, in a stage that
-// stores share columns or not. Every pixel of a quad answers alike from the same inputs,
-// and each mean's sums are the same whichever pixel adds them, so all build the same
-// table, bit for bit.
-MA_FN TableGroup tableGroupOf(int pixel, int x, int width, const PixelCdfInputs* quad, const int* samples,
-                              int shareColumns, int cells) {
-  int i = x - quadFirst(x), j = i ^ 1, places = quadPlaces(x, width);
+// The table `pixel` (at place x) samples alone, with its own inputs: where the stage
+// stores share columns, where its partner lies past the row's end, or its pair does not
+// share.
+MA_FN TableGroup ownTable(int pixel, PixelCdfInputs own) {
   TableGroup g;
   g.first = pixel;
   g.size = 1;
-  g.inputs = quad[i];
-  if (shareColumns) return g;
-  if (places == 4 && samples[0] && samples[1] && samples[2] && samples[3] &&
-      alikeTableInputs(quad[0], quad[1], cells) && alikeTableInputs(quad[2], quad[3], cells)) {
-    PixelCdfInputs low = meanTableInputs(quad[0], quad[1]), high = meanTableInputs(quad[2], quad[3]);
-    if (alikeTableInputs(low, high, cells)) {
-      g.first = pixel - i;
-      g.size = 4;
-      g.inputs = meanTableInputs(low, high);
-      return g;
-    }
-  }
-  if (j < places && samples[j] && alikeTableInputs(quad[i], quad[j], cells)) {
-    g.first = pixel - (i & 1);
-    g.size = 2;
-    g.inputs = meanTableInputs(quad[i], quad[j]);
-  }
+  g.inputs = own;
+  return g;
+}
+
+// Its pair's table, where the pair shares.
+MA_FN TableGroup pairGroup(int pixel, int x, PairTable pair) {
+  TableGroup g;
+  g.first = pixel - (x & 1);
+  g.size = 2;
+  g.inputs = pair.mean;
+  return g;
+}
+
+// Its quad's, where both pairs share and their means are alike; else its pair's. The
+// quad's inputs are the mean of the pairs' means, the same bits whichever pixel adds
+// which. The callers (kernels/sample.cl, pixelTableGroup; the C++ reference) read the
+// other pair's inputs only where the pixel's own pair shares and the row holds the quad,
+// in this order, so that the two pairs are never computed side by side: LLVM's SLP
+// vectoriser would pair them into short vectors (docs/pocl.md, rule 8).
+MA_FN TableGroup quadGroup(int pixel, int x, PairTable pair, PairTable other, int cells) {
+  if (!(other.shares && alikeTableInputs(pair.mean, other.mean, cells))) return pairGroup(pixel, x, pair);
+  TableGroup g;
+  g.first = pixel - x + quadFirst(x);
+  g.size = 4;
+  g.inputs = meanTableInputs(pair.mean, other.mean);
   return g;
 }
 

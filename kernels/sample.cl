@@ -120,25 +120,33 @@ MA_FN PixelCdfInputs pixelCdfInputs(__local const int* pixelRows, int rowStride,
 #undef ROW_FLOAT
 }
 
-// The table that `pixel` samples (kernels/pixel_pairs.h, tableGroupOf), given its own
-// inputs: the others of its quad are read from global memory, where their stage writes
-// them.
+// Pixel q's table inputs and whether it takes samples, read from global memory, where
+// its stage writes them.
+MA_FN PixelCdfInputs storedCdfInputs(__global const float* shadingPoints, __global const int* counts,
+                                     __global const uint* firstIndex, int stageSamples, int q, int* samples) {
+  __global const float* point = shadingPoints + shadingPointOffset(q);
+  StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
+                                  MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
+  *samples = pixelStageSamples(c) > 0;
+  return cdfInputsOf(pointBrdf(point), makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
+                     makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
+}
+
+// The table that `pixel` samples (kernels/pixel_pairs.h), given its own inputs: its
+// quad's, its pair's or its own.
 MA_FN TableGroup pixelTableGroup(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
                                  __global const uint* firstIndex, int stageSamples, int pixel, int imageWidth) {
-  int x = pixel % imageWidth, first = pixel - x + quadFirst(x), places = quadPlaces(x, imageWidth);
-  PixelCdfInputs quad[4];
-  int samples[4];
-  for (int i = 0; i < 4; ++i) {
-    int q = first + (i < places ? i : 0);
-    __global const float* point = shadingPoints + shadingPointOffset(q);
-    StageCounts c = loadStageCounts(counts, firstIndex, q, MA_TECHNIQUES, stageSamples, MA_ONE_SAMPLE,
-                                    MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES);
-    quad[i] = q == pixel ? own
-                         : cdfInputsOf(pointBrdf(point), makeVec3(point[ROW_NORMAL_X], point[ROW_NORMAL_Y], point[ROW_NORMAL_Z]),
-                                       makeVec3(point[ROW_MIRROR_X], point[ROW_MIRROR_Y], point[ROW_MIRROR_Z]), c, HAS_PRODUCT);
-    samples[i] = pixelStageSamples(c) > 0;
-  }
-  return tableGroupOf(pixel, x, imageWidth, quad, samples, MA_SHARE_COLUMNS > 0, MA_PIXEL_CELLS);
+  int x = pixel % imageWidth, row = pixel - x, partner = pairPartner(x);
+  if (MA_SHARE_COLUMNS > 0 || partner >= imageWidth) return ownTable(pixel, own);
+  int partnerSamples, aSamples, bSamples;
+  PixelCdfInputs p = storedCdfInputs(shadingPoints, counts, firstIndex, stageSamples, row + partner, &partnerSamples);
+  PairTable pair = pairTableOf(own, p, partnerSamples, MA_PIXEL_CELLS);
+  if (!pair.shares) return ownTable(pixel, own);
+  if (quadPlaces(x, imageWidth) < 4) return pairGroup(pixel, x, pair);
+  int other = row + otherPairFirst(x);
+  PixelCdfInputs a = storedCdfInputs(shadingPoints, counts, firstIndex, stageSamples, other, &aSamples);
+  PixelCdfInputs b = storedCdfInputs(shadingPoints, counts, firstIndex, stageSamples, other + 1, &bSamples);
+  return quadGroup(pixel, x, pair, pairTableOf(a, b, aSamples && bSamples, MA_PIXEL_CELLS), MA_PIXEL_CELLS);
 }
 
 // The one-sample estimator's pass: the stage's samples, none for the background

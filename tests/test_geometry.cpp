@@ -232,9 +232,10 @@ TEST_CASE("the optimal pdf per pixel is unbiased where quads of pixels share a t
     REQUIRE(scene.grid.width >= 4);
     std::vector<kern::PixelCdfInputs> quad;
     for (int p = 0; p < 4; ++p) quad.push_back(stageCdfInputs(scene, plan, p, 0).first);
-    const std::vector<int> samples(4, 1);
-    REQUIRE(kern::tableGroupOf(0, 0, scene.grid.width, quad.data(), samples.data(), 0, scene.tables.pixelCells).size ==
-            4);
+    const int cells = scene.tables.pixelCells;
+    const kern::PairTable low = kern::pairTableOf(quad[0], quad[1], 1, cells);
+    REQUIRE(low.shares);
+    REQUIRE(kern::quadGroup(0, 0, low, kern::pairTableOf(quad[2], quad[3], 1, cells), cells).size == 4);
     const double expected =
         0.5 * (quadratureValue(c.K, kRhoD, kRhoS, kN, even) + quadratureValue(c.K, kRhoD, kRhoS, kN * 1.03, odd));
     for (Estimator e : {Estimator::MultiSample, Estimator::OneSample})

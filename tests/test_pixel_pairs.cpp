@@ -46,11 +46,19 @@ kern::PixelCdfInputs glossyInputs() {
   return in;
 }
 
-// The table pixel x samples in a row `width` wide whose pixels x & ~3 … have `quad`'s
-// inputs and take samples or not.
+// The table pixel 100 + x samples in a row `width` wide whose quad's pixels have `quad`'s
+// inputs and take samples or not, chosen in the order kernels/sample.cl's
+// pixelTableGroup and the C++ reference's tableInputs choose it.
 kern::TableGroup groupOf(int x, int width, const std::vector<kern::PixelCdfInputs>& quad,
-                         const std::vector<int>& samples, int shareColumns = 0) {
-  return kern::tableGroupOf(100 + x, x, width, quad.data(), samples.data(), shareColumns, kCells);
+                         const std::vector<int>& samples, int shareColumns = 0, int cells = kCells, int pixel = -1) {
+  if (pixel < 0) pixel = 100 + x;
+  const size_t i = size_t(x - kern::quadFirst(x)), j = i ^ 1, o = size_t(kern::otherPairFirst(x) - kern::quadFirst(x));
+  if (shareColumns || kern::pairPartner(x) >= width) return kern::ownTable(pixel, quad[i]);
+  const kern::PairTable pair = kern::pairTableOf(quad[i], quad[j], samples[j], cells);
+  if (!pair.shares) return kern::ownTable(pixel, quad[i]);
+  if (kern::quadPlaces(x, width) < 4) return kern::pairGroup(pixel, x, pair);
+  return kern::quadGroup(pixel, x, pair, kern::pairTableOf(quad[o], quad[o + 1], samples[o] && samples[o + 1], cells),
+                         cells);
 }
 
 // Pixels a and b, places 0 and 1 of a row of two, where b takes samples or not.
@@ -243,8 +251,7 @@ TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit
       std::vector<int> samples(4, 0);
       for (int i = 0; i < kern::quadPlaces(x, width); ++i)
         std::tie(quad[size_t(i)], samples[size_t(i)]) = stageCdfInputs(scene, plan, first + i, product);
-      if (samples[size_t(x - kern::quadFirst(x))])
-        ++groups[kern::tableGroupOf(p, x, width, quad.data(), samples.data(), 0, scene.tables.pixelCells).size];
+      if (samples[size_t(x - kern::quadFirst(x))]) ++groups[groupOf(x, width, quad, samples, 0, scene.tables.pixelCells, p).size];
     }
     INFO("alone " << groups[1] << ", in pairs " << groups[2] << ", in quads " << groups[4]);
     CHECK(groups[1] > 10);

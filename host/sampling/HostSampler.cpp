@@ -83,18 +83,25 @@ kern::PixelCdfInputs cdfInputsOf(const kern::ShadingPoint& sp, const kern::Stage
 }
 
 // The inputs of the table that `pixel` samples, given its own: its quad's, its pair's or
-// its own (kernels/pixel_pairs.h), as kernels/sample.cl's pixelTableGroup chooses.
+// its own (kernels/pixel_pairs.h), read in the order kernels/sample.cl's pixelTableGroup
+// reads them.
 kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, const SamplerConfig& config, int pixel,
                                  const kern::PixelCdfInputs& own, const kern::TechniqueSet& ts, int cells) {
-  const int width = scene.grid.width, x = pixel % width, first = pixel - x + kern::quadFirst(x);
-  kern::PixelCdfInputs quad[4];
-  int samples[4] = {0, 0, 0, 0};
-  for (int i = 0; i < kern::quadPlaces(x, width); ++i) {
-    const kern::StageCounts c = stageCountsOf(plan, config, first + i);
-    quad[i] = first + i == pixel ? own : cdfInputsOf(makeShadingPoint(scene, first + i), c, ts);
-    samples[i] = kern::pixelStageSamples(c) > 0;
-  }
-  return kern::tableGroupOf(pixel, x, width, quad, samples, ts.sharePdfs, cells).inputs;
+  const int width = scene.grid.width, x = pixel % width, row = pixel - x, partner = kern::pairPartner(x);
+  if (ts.sharePdfs || partner >= width) return own;
+  auto inputsOf = [&](int q, int& samples) {
+    const kern::StageCounts c = stageCountsOf(plan, config, q);
+    samples = kern::pixelStageSamples(c) > 0;
+    return cdfInputsOf(makeShadingPoint(scene, q), c, ts);
+  };
+  int partnerSamples = 0, aSamples = 0, bSamples = 0;
+  const kern::PixelCdfInputs p = inputsOf(row + partner, partnerSamples);
+  const kern::PairTable pair = kern::pairTableOf(own, p, partnerSamples, cells);
+  if (!pair.shares) return own;
+  if (kern::quadPlaces(x, width) < 4) return pair.mean;
+  const int other = row + kern::otherPairFirst(x);
+  const kern::PixelCdfInputs a = inputsOf(other, aSamples), b = inputsOf(other + 1, bSamples);
+  return kern::quadGroup(pixel, x, pair, kern::pairTableOf(a, b, aSamples && bSamples, cells), cells).inputs;
 }
 
 }  // namespace
