@@ -113,9 +113,9 @@ typedef struct {
 
 // The envmap's pdf at ω_i in texel t under the table of every share: the bank's entries
 // of the pixel's BRDF bin, or the tables the optimal pdf per pixel would build.
-MA_FN void envmapSharePdfs(EnvmapView env, ShadingPoint sp, int t, float sinTheta, float* pdfs) {
+MA_FN void envmapSharePdfs(EnvmapView env, int t, float sinTheta, float* pdfs) {
   if (env.pixelCells > 0)
-    pixelSharePdfs(env, sp.brdf, sp.normalFrame.z, sp.mirrorFrame.z, t, sinTheta, pdfs);
+    pixelSharePdfs(env, t, sinTheta, pdfs);
   else
     bankSharePdfs(env, t, sinTheta, pdfs);
 }
@@ -139,7 +139,7 @@ MA_FN SampleValue evaluateSample(TechniqueSet ts, EnvmapView env, ShadingPoint s
   techniquePdfs(ts, env, sp, wi, texel, sinTheta, hit.pdf, lobe, s.pdfs);
   MA_UNROLL
   for (int share = 0; share < MA_MAX_BANK_SHARES; ++share) s.sharePdfs[share] = 0.0f;
-  if (ts.sharePdfs) envmapSharePdfs(env, sp, texel, sinTheta, s.sharePdfs);
+  if (ts.sharePdfs) envmapSharePdfs(env, texel, sinTheta, s.sharePdfs);
   return s;
 }
 

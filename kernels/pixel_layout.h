@@ -43,23 +43,27 @@ enum {
   (MA_ROW_PRODUCT(optimalWeights, techniqueCount) + ((product) ? 3 : 0))
 // The optimal pdf per pixel's rows: its CDF's pixelCells + 1 entries, then the build's
 // scratch, 2 pixelCells entries and 4 per chunk (kernels/pixel_optimal.h, CHUNK_SUMS),
-// then the scales of the tables of the share columns' shares, 1 + 3 per
-// share for at most 3 shares (kernels/pixel_optimal.h, SHARE_ROWS; MA_MAX_BANK_SHARES),
 // then with the product technique from the same cells (productCells) its CDF's
-// pixelCells + 1 entries.
+// pixelCells + 1 entries, then with the share columns (shareColumns) each share's
+// table's mass in each cell, 3 pixelCells entries for at most 3 shares
+// (MA_MAX_BANK_SHARES, kernels/pixel_optimal.h, MA_SHARE_MASS_ROW), after the product's rows, which are
+// kept for them whether the product technique runs or not.
 #define MA_PIXEL_CHUNKS 16
-#define MA_PIXEL_SHARE_ROWS 10
-#define MA_PIXEL_CDF_ROWS(pixelCells, productCells)                                                                 \
-  ((pixelCells) > 0                                                                                                 \
-       ? 3 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + ((productCells) ? (pixelCells) + 1 : 0) \
-       : 0)
-#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells) \
-  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells))
+#define MA_PIXEL_SHARE_MASS_ROWS(pixelCells) (3 * (pixelCells))
+#define MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns)                                              \
+  ((pixelCells) > 0 ? 3 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS +                                      \
+                          ((productCells) || (shareColumns) ? (pixelCells) + 1 : 0) +                 \
+                          ((shareColumns) ? MA_PIXEL_SHARE_MASS_ROWS(pixelCells) : 0)                 \
+                    : 0)
+#define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells, shareColumns) \
+  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns))
 
 // product: the product technique's mixture rows (its tables, kernels/product.h);
-// productCells: its CDF over the optimal pdf's cells.
-MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells, int productCells) {
-  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells);
+// productCells: its CDF over the optimal pdf's cells; shareColumns: the stored samples'
+// share columns (kernels/stats.h), whose pdfs the cells' masses give.
+MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int pixelCells, int productCells,
+                        int shareColumns) {
+  return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells, shareColumns);
 }
 
 // samplePixelStage's chunk of sample terms (kernels/sample.cl): per term, a float for

@@ -24,8 +24,8 @@
 // no longer split one build among lanes; they remain the CDF's order.
 //
 // A stage that stores its samples for the grid search of `exact` (kernels/stats.h, share
-// columns) also keeps the scales of the tables that stages of the shares C = 1/4, 1/2,
-// 3/4 would build: each sample then carries its pdf under each, and the search judges
+// columns) also keeps each cell's mass in the tables that stages of the shares C = 1/4,
+// 1/2, 3/4 would build: each sample then carries its pdf under each, and the search judges
 // each α_0 by the table of the share nearest it ([Kar19] Sec. 10's joint choice of the
 // pdf and the allocation), as it does with the bank's entries.
 //
@@ -76,8 +76,8 @@ enum {
 
 // The rows (kernels/pixel_layout.h, MA_PIXEL_CDF_ROWS) from the CDF's first: the CDF's
 // count + 1 entries in its order (cdfPositionOfCell), as float bits; then each cell's
-// p_ρ mass and its f in the cells' order (the share columns read the p_ρ masses; pass 4
-// leaves each cell's table mass in place of its f); then
+// p_ρ mass and its f in the cells' order (pass 4 leaves each cell's table mass in place
+// of its f); then
 // per chunk its Σ f, Σ p_ρ, Σ plain and Σ of eq. 6's terms. (f in the CDF's rows, at its
 // cell's position, would save count rows, but pass 1's stores would no longer lie side
 // by side, and the compiler no longer vectorises it: 2.2× the time of the pilot stage.)
@@ -86,24 +86,14 @@ enum {
 #define MA_F_ROW(count, c) (2 * (count) + 1 + (c))
 enum { CHUNK_F, CHUNK_BRDF, CHUNK_PLAIN, CHUNK_EQ6, CHUNK_SUMS };
 #define MA_CHUNK_ROW(count, sum, j) (3 * (count) + 1 + (sum)*MA_PIXEL_CHUNKS + (j))
-// Then, for the share columns, 1/F and per share its table's (1−C)/B, optimal and plain
-// scales: MA_PIXEL_SHARE_ROWS (kernels/pixel_layout.h) rows. Each share's three lie
-// together, so that no two shares' scales of a kind are adjacent words: the search's
-// shares, computed alike from adjacent words, would be paired into short vectors
-// (docs/pocl.md, rule 8).
-enum {
-  SHARE_INV_F,
-  SHARE_BRDF_SCALE,
-  SHARE_OPTIMAL,
-  SHARE_PLAIN,
-  SHARE_FIELDS = SHARE_PLAIN,
-  SHARE_ROWS = 1 + SHARE_FIELDS * MA_MAX_BANK_SHARES
-};
-// Share s's field (SHARE_BRDF_SCALE, SHARE_OPTIMAL or SHARE_PLAIN).
-#define MA_SHARE_FIELD(s, field) (SHARE_FIELDS * (s) + (field))
-#define MA_SHARE_ROW(count, q) (MA_CHUNK_ROW(count, CHUNK_SUMS, 0) + (q))
 // Then the product technique's CDF, count + 1 entries.
-#define MA_PRODUCT_CDF_ROW(count, c) (MA_SHARE_ROW(count, SHARE_ROWS) + (c))
+#define MA_PRODUCT_CDF_ROW(count, c) (MA_CHUNK_ROW(count, CHUNK_SUMS, 0) + (c))
+// Then, for the share columns, share s's table's mass in cell c, in the cells' order
+// (MA_PIXEL_SHARE_MASS_ROWS, for MA_MAX_BANK_SHARES shares), the product's rows before
+// them whether it runs or not. The shares of a cell lie count words apart: adjacent, the
+// search's shares, computed alike from adjacent words, would be paired into short
+// vectors (docs/pocl.md, rule 8).
+#define MA_SHARE_MASS_ROW(count, s, c) (MA_PRODUCT_CDF_ROW(count, (count) + 1) + (s) * (count) + (c))
 
 MA_FN float rowFloat(MA_LOCAL const int* rows, int stride, int r) { return ma_as_float((ma_uint)rows[r * stride]); }
 MA_FN void setRowFloat(MA_LOCAL int* rows, int stride, int r, float v) { rows[r * stride] = (int)ma_as_uint(v); }
@@ -417,42 +407,50 @@ MA_FN float columnShare(int s) { return (float)(s + 1) / (float)(MA_MAX_BANK_SHA
 
 // Eq. 6's mass under terms t, summed as pass 3 sums it (chunk by chunk, then over the
 // chunks): the same bits as the stage's own where C is the same. Its chunks' sums go to
-// the CDF's first rows, which pass 4 writes later. A sum over the cells in order is one
-// chain of dependent additions, which a lane's own build (samplePixelStage: vectorised
-// over the cells, not across pixels) cannot overlap.
-MA_FN float eq6MassByChunks(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, MA_LOCAL int* rows, int stride) {
+// the CDF's first rows, which pass 4 writes later; each cell's term to share s's mass
+// rows, which pixelShareMasses scales. A sum over the cells in order is one chain of
+// dependent additions, which a lane's own build (samplePixelStage: vectorised over the
+// cells, not across pixels) cannot overlap.
+MA_FN float eq6MassByChunks(MA_GLOBAL const float* cells, int count, PixelOptimalTerms t, int s, MA_LOCAL int* rows,
+                            int stride) {
   int chunks = count < MA_PIXEL_CHUNKS ? count : MA_PIXEL_CHUNKS;
   for (int j = 0; j < chunks; ++j) setRowFloat(rows, stride, MA_CDF_ROW(j), 0.0f);
   for (int first = 0; first < count; first += MA_PIXEL_CHUNKS)
-    for (int j = 0; j < chunksFrom(count, first); ++j)
-      addToRowFloat(rows, stride, MA_CDF_ROW(j), eq6Term(cells, rows, stride, count, first + j, t));
+    for (int j = 0; j < chunksFrom(count, first); ++j) {
+      float term = eq6Term(cells, rows, stride, count, first + j, t);
+      setRowFloat(rows, stride, MA_SHARE_MASS_ROW(count, s, first + j), term);
+      addToRowFloat(rows, stride, MA_CDF_ROW(j), term);
+    }
   float mass = 0.0f;
   for (int j = 0; j < chunks; ++j) mass += rowFloat(rows, stride, MA_CDF_ROW(j));
   return mass;
 }
 
-// Pass 3b, for the share columns, while the rows hold each cell's f: 1/F, and per share
-// its (1−C)/B and its table's scales. Only the search reads them.
+// Share s's table's mass in each cell, from its eq. 6 terms in place: each stored
+// sample's pdf under the share then reads one row, where taking the cell's f again
+// per sample (its frame's lobe, a gather of the cell's fields) made exact's pilot 4–5×
+// as slow per sample as a stage without share columns (docs/results.md, "The share
+// columns' masses kept per cell").
+MA_FN void pixelShareMasses(MA_GLOBAL const float* cells, int count, int s, PixelTableScales scales, MA_LOCAL int* rows,
+                            int stride) {
+  MA_CELL_LOOP
+  for (int c = 0; c < count; ++c) {
+    int row = MA_SHARE_MASS_ROW(count, s, c);
+    setRowFloat(rows, stride, row,
+                cellTableMass(scales, rowFloat(rows, stride, row), cellField(cells, count, c, CELL_PLAIN)));
+  }
+}
+
+// Pass 3b, for the share columns, while the rows hold each cell's f: per share its
+// table's scales, and its mass in each cell. Only the search reads them.
 MA_FN void pixelOptimalShareScales(MA_GLOBAL const float* cells, int count, MA_LOCAL int* rows, int stride) {
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, columnShare(s));
     // A stage of share C_s < 1 draws BRDF samples.
-    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(cells, count, t, rows, stride), plain, 1);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F), t.invF);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_BRDF_SCALE)), t.brdfScale);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)), scales.optimal);
-    setRowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_PLAIN)), scales.plain);
+    PixelTableScales scales = tableScalesOf(t, eq6MassByChunks(cells, count, t, s, rows, stride), plain, 1);
+    pixelShareMasses(cells, count, s, scales, rows, stride);
   }
-}
-
-// Share s's eq. 6 terms, from the rows pass 3b wrote.
-MA_FN PixelOptimalTerms shareTerms(MA_LOCAL const int* rows, int stride, int count, int s) {
-  PixelOptimalTerms t;
-  t.invF = rowFloat(rows, stride, MA_SHARE_ROW(count, SHARE_INV_F));
-  t.brdfScale = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_BRDF_SCALE)));
-  t.lit = 1;
-  return t;
 }
 
 // The product technique's terms and table scales (eq. 6 at C = 1).
@@ -504,23 +502,14 @@ MA_FN EnvmapView pixelProductView(EnvmapView env) {
 }
 
 // The envmap's pdf at ω in texel t under the table of each share (stats.h's share
-// columns), from the scales pass 3b kept, the cell's f taken again and its p_ρ, which
-// the rows keep.
-MA_FN void pixelSharePdfs(EnvmapView env, PhongParams b, MaVec3 normal, MaVec3 mirror, int t, float sinTheta,
-                          float* pdfs) {
+// columns), from the cell's masses pass 3b kept.
+MA_FN void pixelSharePdfs(EnvmapView env, int t, float sinTheta, float* pdfs) {
   MA_LOCAL const int* rows = env.pixelCdf;
   int count = env.pixelCells, stride = env.pixelCdfStride, c = blockOfTexel(env, t);
-  PixelCell cell = pixelCellAt(env.blockProbs, count, c);
-  float f = cellIntegrand(cell, b, normal, mirror), q = rowFloat(rows, stride, MA_BRDF_ROW(count, c));
-  float plain = cell.plain, inCell = env.texels[4 * t + 3];
+  float inCell = env.texels[4 * t + 3];
   MA_UNROLL
-  for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
-    PixelOptimalTerms terms = shareTerms(rows, stride, count, s);
-    PixelTableScales scales;
-    scales.optimal = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_OPTIMAL)));
-    scales.plain = rowFloat(rows, stride, MA_SHARE_ROW(count, MA_SHARE_FIELD(s, SHARE_PLAIN)));
-    pdfs[s] = envmapPdfOfTexel(env, inCell * cellTableMass(scales, cellEq6(env.blockProbs, count, c, f, q, terms), plain), sinTheta);
-  }
+  for (int s = 0; s < MA_MAX_BANK_SHARES; ++s)
+    pdfs[s] = envmapPdfOfTexel(env, inCell * rowFloat(rows, stride, MA_SHARE_MASS_ROW(count, s, c)), sinTheta);
 }
 
 #endif

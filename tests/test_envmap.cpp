@@ -78,7 +78,7 @@ kern::EnvmapView pixelOptimalView(const EnvmapTables& tables, const PixelOptimal
                                   bool shareColumns, std::vector<int>& rows, bool productCdf = false,
                                   std::optional<bool> brdfCovers = {}) {
   kern::EnvmapView view = viewOf(tables);
-  rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells, productCdf), 0);
+  rows.assign(MA_PIXEL_CDF_ROWS(tables.pixelCells, productCdf, shareColumns), 0);
   kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, point.brdf, point.normal, point.mirror, share,
                              brdfCovers.value_or(drawsBrdf(share)) ? 1 : 0, shareColumns ? 1 : 0, productCdf ? 1 : 0,
                              rows.data(), 1);
@@ -596,8 +596,8 @@ TEST_CASE(
 TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables built for their shares",
           "[envmap][optimal]") {
   // The grid search of `exact` judges each α_0 by a stored sample's pdf under the share
-  // nearest it (kernels/stats.h's share columns), which pixelSharePdfs evaluates from
-  // scales kept beside the stage's own table. At every texel, each must be the pdf of the
+  // nearest it (kernels/stats.h's share columns), which pixelSharePdfs reads from the
+  // cells' masses kept beside the stage's own table. At every texel, each must be the pdf of the
   // table that a stage of that share builds, up to the rounding of that table's CDF
   // entries to the uniform's grid (the scales sum eq. 6 in the stage's order): a cell's
   // probability within 8 steps of the grid, as the product's test above bounds it
@@ -618,7 +618,7 @@ TEST_CASE("the optimal pdf per pixel's share columns hold the pdfs of the tables
         std::size_t mismatches = 0, positive = 0;
         for (int t = 0; t < tables.width * tables.height; ++t) {
           float pdfs[MA_MAX_BANK_SHARES];
-          kern::pixelSharePdfs(stage, point.brdf, point.normal, point.mirror, t, sinTheta, pdfs);
+          kern::pixelSharePdfs(stage, t, sinTheta, pdfs);
           const double expected = kern::envmapPdfOfTexel(built, kern::texelProbability(built, t), sinTheta);
           const double slack = 1e-4 * expected + perProbability * tables.texels[4 * t + 3] * 8 / kGrid24;
           mismatches += !(std::abs(pdfs[share] - expected) <= slack);
@@ -655,7 +655,7 @@ TEST_CASE("the optimal pdf per pixel keeps its cells within what its search reac
   EnvmapTables tables = misalloc::buildPixelOptimalEnvmapTables(tall);
   REQUIRE(tables.pixelCells == MA_MAX_PIXEL_CELLS);
   kern::EnvmapView view = viewOf(tables);
-  std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells, 0));
+  std::vector<int> rows(MA_PIXEL_CDF_ROWS(tables.pixelCells, 0, 0));
   const kern::MaVec3 up = kern::makeVec3(0, 0, 1);
   kern::buildPixelOptimalCdf(tables.blockProbs.data(), tables.pixelCells, {0.5f, 0.5f, 20.0f}, up, up, 0.5f, 1, 0, 0,
                              rows.data(), 1);

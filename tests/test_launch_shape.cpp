@@ -36,7 +36,7 @@ int statSlotsOf(Method method, bool split) {
 
 std::function<size_t(int)> sampleBytes(int statSlots) {
   return [statSlots](int size) {
-    return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0, 0));
+    return sampleKernelLocalBytes(size, statSlots, true, kern::pixelRowCount(0, 2, 0, 0, 0, 0));
   };
 }
 
@@ -54,14 +54,17 @@ TEST_CASE("launch shape: sampleStage's local memory: 9 sums, the running sums, t
   CHECK(sampleKernelLocalBytes(8, 20, true, 16) == 8 * (29 * 8 + 17 * 4));  // optimal weights, M = 2
   // The pixel's rows: BRDF (4), normal (3), mirror direction (3), counts (3), first
   // indices (3); 3M coefficients; 3 product; the optimal pdf per pixel's CDF over its
-  // cells (cells + 1), its scratch (2 × cells), 4 sums per chunk of cells and the share
-  // columns' scales; the product's CDF over the same cells (cells + 1).
-  CHECK(kern::pixelRowCount(0, 2, 0, 0, 0) == 16);
-  CHECK(kern::pixelRowCount(1, 2, 0, 0, 0) == 22);
-  CHECK(kern::pixelRowCount(1, 3, 1, 0, 0) == 28);
-  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS);
-  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + MA_PIXEL_SHARE_ROWS + 129);
-  static_assert(kern::SHARE_ROWS == MA_PIXEL_SHARE_ROWS, "the share columns' rows of kernels/pixel_optimal.h");
+  // cells (cells + 1), its scratch (2 × cells) and 4 sums per chunk of cells; the
+  // product's CDF over the same cells (cells + 1); the share columns' masses, 3 per cell,
+  // after the product's rows, which they keep.
+  CHECK(kern::pixelRowCount(0, 2, 0, 0, 0, 0) == 16);
+  CHECK(kern::pixelRowCount(1, 2, 0, 0, 0, 0) == 22);
+  CHECK(kern::pixelRowCount(1, 3, 1, 0, 0, 0) == 28);
+  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0, 0) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS);
+  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1, 0) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + 129);
+  CHECK(kern::pixelRowCount(0, 2, 0, 128, 0, 1) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + 129 + 3 * 128);
+  CHECK(kern::pixelRowCount(0, 3, 0, 128, 1, 1) == 16 + 129 + 256 + 4 * MA_PIXEL_CHUNKS + 129 + 3 * 128);
+  static_assert(MA_PIXEL_SHARE_MASS_ROWS(1) == MA_MAX_BANK_SHARES, "a mass per share column and cell");
   // samplePixelStage: each pixel's rows in a power-of-two block, then one pixel's rows
   // two words apart (and its index), 5 terms of 8 passes a lane and the sums.
   CHECK(kern::pixelRowBlock(16) == 256);

@@ -158,7 +158,7 @@ StageResult HostSampler::runPixels(const StagePlan& plan, uint64_t seed, int fir
     if (ts.product.tables > 0) pixelTs.productMixture = kern::productMixture(ts.product, sp.brdf);
     const kern::StageCounts c = stageCountsOf(plan, config_, pixel);
     const kern::OptimalCoefficients a = optimalCoefficients(plan, pixel, M);
-    std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells));
+    std::vector<int> pixelCdf(MA_PIXEL_CDF_ROWS(env.pixelCells, ts.product.pixelCells, ts.sharePdfs));
     if (env.pixelCells > 0 && kern::pixelStageSamples(c) > 0) {
       const kern::PixelCdfInputs in =
           tableInputs(scene_, plan, config_, pixel, cdfInputsOf(sp, c, ts), ts, env.pixelCells);

@@ -81,7 +81,8 @@ int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int device
 
 int samplePixelRows(const Scene& scene, const SamplerConfig& config) {
   return kern::pixelRowCount(config.optimalWeights, scene.techniqueCount(), scene.productTables.tables > 0,
-                             stageTables(scene, keepsStatistics(config)).pixelCells, scene.productTables.pixelCells);
+                             stageTables(scene, keepsStatistics(config)).pixelCells, scene.productTables.pixelCells,
+                             sampleColumns(scene, config).shareColumns > 0);
 }
 
 int pixelStageGroupPixels(const Scene& scene, const SamplerConfig& config, int lanes, uint64_t localMemBytes) {
