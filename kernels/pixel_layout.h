@@ -46,17 +46,18 @@ enum {
 // then with the product technique from the same cells (productCells) its CDF's
 // pixelCells + 1 entries, then with the share columns (shareColumns) each share's
 // table's mass in each cell, 3 pixelCells entries for at most 3 shares
-// (MA_MAX_BANK_SHARES, kernels/pixel_optimal.h, MA_SHARE_MASS_ROW), after the product's rows, which are
-// kept for them whether the product technique runs or not.
+// (MA_MAX_BANK_SHARES; kernels/pixel_optimal.h, MA_SHARE_MASS_ROW), after the product's
+// rows, which are kept for them whether the product technique runs or not.
 #define MA_PIXEL_CHUNKS 16
 #define MA_PIXEL_SHARE_MASS_ROWS(pixelCells) (3 * (pixelCells))
-#define MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns)                                              \
-  ((pixelCells) > 0 ? 3 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS +                                      \
-                          ((productCells) || (shareColumns) ? (pixelCells) + 1 : 0) +                 \
-                          ((shareColumns) ? MA_PIXEL_SHARE_MASS_ROWS(pixelCells) : 0)                 \
-                    : 0)
+#define MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns)                                                 \
+  ((pixelCells) > 0                                                                                               \
+       ? 3 * (pixelCells) + 1 + 4 * MA_PIXEL_CHUNKS + ((productCells) || (shareColumns) ? (pixelCells) + 1 : 0) + \
+             ((shareColumns) ? MA_PIXEL_SHARE_MASS_ROWS(pixelCells) : 0)                                          \
+       : 0)
 #define MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells, shareColumns) \
-  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) + MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns))
+  (MA_ROW_PIXEL_CDF(optimalWeights, techniqueCount, product) +                                              \
+   MA_PIXEL_CDF_ROWS(pixelCells, productCells, shareColumns))
 
 // product: the product technique's mixture rows (its tables, kernels/product.h);
 // productCells: its CDF over the optimal pdf's cells; shareColumns: the stored samples'

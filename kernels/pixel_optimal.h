@@ -442,7 +442,7 @@ MA_FN void pixelShareMasses(MA_GLOBAL const float* cells, int count, int s, Pixe
 }
 
 // Pass 3b, for the share columns, while the rows hold each cell's f: per share its
-// table's scales, and its mass in each cell. Only the search reads them.
+// table's mass in each cell, from the table's scales. Only the search reads them.
 MA_FN void pixelOptimalShareScales(MA_GLOBAL const float* cells, int count, MA_LOCAL int* rows, int stride) {
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
