@@ -10,8 +10,9 @@
 // (the table's plain share covers every lit texel). The pixels that share a table are
 // fixed by their places in their row, so a pixel's table does not depend on the launch
 // that samples it: its work-group, its device's tiles, its band (whole rows:
-// render/Band.h). A stage that stores share columns (kernels/stats.h) keeps each pixel's
-// own table: its samples carry pdfs recomputed from the pixel's own inputs.
+// render/Band.h). A stage that stores share columns (kernels/stats.h: `exact`'s pilot)
+// shares as well: its samples carry the pdfs of the group's table under each share, the
+// table they were drawn from, and so judge α_0 for the group's inputs, which are alike.
 #include "namespace_check.h"
 #ifndef MA_PIXEL_PAIRS_H
 #define MA_PIXEL_PAIRS_H
@@ -104,9 +105,8 @@ MA_FN int quadPlaces(int x, int width) { return width - quadFirst(x) < 4 ? width
 MA_FN int pairPartner(int x) { return x ^ 1; }
 MA_FN int otherPairFirst(int x) { return quadFirst(x) + ((x & 2) ^ 2); }
 
-// The table `pixel` (at place x) samples alone, with its own inputs: where the stage
-// stores share columns, where its partner lies past the row's end, or its pair does not
-// share.
+// The table `pixel` (at place x) samples alone, with its own inputs: where its partner
+// lies past the row's end, or its pair does not share.
 MA_FN TableGroup ownTable(int pixel, PixelCdfInputs own) {
   TableGroup g;
   g.first = pixel;

@@ -138,7 +138,7 @@ MA_FN PixelCdfInputs storedCdfInputs(__global const float* shadingPoints, __glob
 MA_FN TableGroup pixelTableGroup(PixelCdfInputs own, __global const float* shadingPoints, __global const int* counts,
                                  __global const uint* firstIndex, int stageSamples, int pixel, int imageWidth) {
   int x = pixel % imageWidth, row = pixel - x, partner = pairPartner(x);
-  if (MA_SHARE_COLUMNS > 0 || partner >= imageWidth) return ownTable(pixel, own);
+  if (partner >= imageWidth) return ownTable(pixel, own);
   int partnerSamples, aSamples, bSamples;
   PixelCdfInputs p = storedCdfInputs(shadingPoints, counts, firstIndex, stageSamples, row + partner, &partnerSamples);
   PairTable pair = pairTableOf(own, p, partnerSamples, MA_PIXEL_CELLS);

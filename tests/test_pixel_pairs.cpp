@@ -11,6 +11,7 @@
 #include "KernelCode.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
+#include "alloc/GridSearch.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
 
@@ -50,10 +51,10 @@ kern::PixelCdfInputs glossyInputs() {
 // inputs and take samples or not, chosen in the order kernels/sample.cl's
 // pixelTableGroup and the C++ reference's tableInputs choose it.
 kern::TableGroup groupOf(int x, int width, const std::vector<kern::PixelCdfInputs>& quad,
-                         const std::vector<int>& samples, int shareColumns = 0, int cells = kCells, int pixel = -1) {
+                         const std::vector<int>& samples, int cells = kCells, int pixel = -1) {
   if (pixel < 0) pixel = 100 + x;
   const size_t i = size_t(x - kern::quadFirst(x)), j = i ^ 1, o = size_t(kern::otherPairFirst(x) - kern::quadFirst(x));
-  if (shareColumns || kern::pairPartner(x) >= width) return kern::ownTable(pixel, quad[i]);
+  if (kern::pairPartner(x) >= width) return kern::ownTable(pixel, quad[i]);
   const kern::PairTable pair = kern::pairTableOf(quad[i], quad[j], samples[j], cells);
   if (!pair.shares) return kern::ownTable(pixel, quad[i]);
   if (kern::quadPlaces(x, width) < 4) return kern::pairGroup(pixel, x, pair);
@@ -62,8 +63,8 @@ kern::TableGroup groupOf(int x, int width, const std::vector<kern::PixelCdfInput
 }
 
 // Pixels a and b, places 0 and 1 of a row of two, where b takes samples or not.
-bool pairs(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b, int bSamples = 1, int shareColumns = 0) {
-  return groupOf(0, 2, {a, b, a, a}, {1, bSamples, 0, 0}, shareColumns).size == 2;
+bool pairs(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b, int bSamples = 1) {
+  return groupOf(0, 2, {a, b, a, a}, {1, bSamples, 0, 0}).size == 2;
 }
 
 bool sameBits(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
@@ -79,9 +80,8 @@ bool sameBits(const kern::PixelCdfInputs& a, const kern::PixelCdfInputs& b) {
 TEST_CASE("two pixels share a table only where their inputs are alike", "[pairs]") {
   const kern::PixelCdfInputs a = glossyInputs();
   CHECK(pairs(a, a));
-  // Neither the stage's share columns nor a partner without samples.
+  // Not a partner without samples.
   CHECK_FALSE(pairs(a, a, 0));
-  CHECK_FALSE(pairs(a, a, 1, 1));
   // One draws BRDF samples and the other none: the table's plain share differs, and
   // without it the second's texels that eq. 6 clips could not be drawn.
   kern::PixelCdfInputs b = a;
@@ -179,8 +179,6 @@ TEST_CASE("four pixels share a table where both pairs and their means are alike"
   CHECK(groupOf(4, 6, quad, all).size == 2);
   CHECK(groupOf(5, 6, quad, all).first == 104);
   CHECK(groupOf(4, 5, quad, all).size == 1);
-  // A stage that stores share columns keeps each pixel's own.
-  CHECK(groupOf(2, 8, quad, all, 1).size == 1);
 }
 
 namespace {
@@ -251,26 +249,37 @@ TEST_CASE("pairs of pixels sample one table on PoCL as on the C++ reference, bit
       std::vector<int> samples(4, 0);
       for (int i = 0; i < kern::quadPlaces(x, width); ++i)
         std::tie(quad[size_t(i)], samples[size_t(i)]) = stageCdfInputs(scene, plan, first + i, product);
-      if (samples[size_t(x - kern::quadFirst(x))]) ++groups[groupOf(x, width, quad, samples, 0, scene.tables.pixelCells, p).size];
+      if (samples[size_t(x - kern::quadFirst(x))]) ++groups[groupOf(x, width, quad, samples, scene.tables.pixelCells, p).size];
     }
     INFO("alone " << groups[1] << ", in pairs " << groups[2] << ", in quads " << groups[4]);
     CHECK(groups[1] > 10);
     CHECK(groups[2] > 10);
     CHECK(groups[4] > 10);
-    const SamplerConfig config{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 0};
-    Sampler device(testDevice(), scene, config);
-    HostSampler host(scene, config);
-    size_t mismatches = 0;
-    for (int stage = 0; stage < 2; ++stage) {
-      StagePlan s = plan;
-      s.keepStatistics = stage == 0;
-      s.samplesBefore = 40 * stage;
-      for (size_t i = 0; i < plan.counts.size(); ++i) s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
-      StageResult a = device.run(s, 7), b = host.run(s, 7);
-      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+    // Running sums; and `exact`'s pilot, whose stored samples carry the pdfs of the
+    // group's table under each share (its share columns), without the product, which
+    // kernel = reference crosses with them.
+    SamplerConfig shareColumns{Estimator::MultiSample, 0, 40, kDefaultGridSize};
+    shareColumns.shareColumns = true;
+    std::vector<SamplerConfig> configs = {{Estimator::MultiSample, MA_STATS_TECHNIQUE | MA_STATS_LINEAR, 0}};
+    if (!product) configs.push_back(shareColumns);
+    for (const SamplerConfig& config : configs) {
+      Sampler device(testDevice(), scene, config);
+      HostSampler host(scene, config);
+      size_t mismatches = 0;
+      for (int stage = 0; stage < 2; ++stage) {
+        StagePlan s = plan;
+        s.keepStatistics = stage == 0;
+        s.samplesBefore = 40 * stage;
+        for (size_t i = 0; i < plan.counts.size(); ++i) s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
+        StageResult a = device.run(s, 7), b = host.run(s, 7);
+        for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
+        for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+      }
+      std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
+      REQUIRE(storedA.size() == storedB.size());
+      for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
+      INFO("product " << product << ", share columns " << config.shareColumns);
+      CHECK(mismatches == 0);
     }
-    INFO("product " << product);
-    CHECK(mismatches == 0);
   }
 }

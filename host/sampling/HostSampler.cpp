@@ -88,7 +88,7 @@ kern::PixelCdfInputs cdfInputsOf(const kern::ShadingPoint& sp, const kern::Stage
 kern::PixelCdfInputs tableInputs(const Scene& scene, const StagePlan& plan, const SamplerConfig& config, int pixel,
                                  const kern::PixelCdfInputs& own, const kern::TechniqueSet& ts, int cells) {
   const int width = scene.grid.width, x = pixel % width, row = pixel - x, partner = kern::pairPartner(x);
-  if (ts.sharePdfs || partner >= width) return own;
+  if (partner >= width) return own;
   auto inputsOf = [&](int q, int& samples) {
     const kern::StageCounts c = stageCountsOf(plan, config, q);
     samples = kern::pixelStageSamples(c) > 0;
