@@ -130,4 +130,18 @@ inline double closedForm(double rhoD, double rhoS, double n, double K) {
   return 2 * rhoD / (K + 2) + rhoS * (n + 2) / (n + K + 2);
 }
 
+// Values of a and b that differ bit for bit, a length's difference counted as that many:
+// a kernel against its C++ reference.
+template <typename T>
+size_t differingValues(const std::vector<T>& a, const std::vector<T>& b) {
+  size_t differ = std::max(a.size(), b.size()) - std::min(a.size(), b.size());
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) differ += a[i] != b[i];
+  return differ;
+}
+
+// A stage's sums that differ between two samplers: the image's and the techniques' moments.
+inline size_t stageMismatches(const StageResult& a, const StageResult& b) {
+  return differingValues(a.rgb, b.rgb) + differingValues(a.moments, b.moments);
+}
+
 }  // namespace misalloc::test

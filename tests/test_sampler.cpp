@@ -122,16 +122,10 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
         s.counts[i] = plan.counts[i] * scale;
         s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
       }
-      StageResult a = device.run(s, 42), b = host.run(s, 42);
-      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+      mismatches += stageMismatches(device.run(s, 42), host.run(s, 42));
     }
-    std::vector<double> statsA = device.statistics(), statsB = host.statistics();
-    REQUIRE(statsA.size() == statsB.size());
-    for (size_t i = 0; i < statsA.size(); ++i) mismatches += statsA[i] != statsB[i];
-    std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
-    REQUIRE(storedA.size() == storedB.size());
-    for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
+    mismatches += differingValues(device.statistics(), host.statistics());
+    mismatches += differingValues(device.storedSamples(), host.storedSamples());
     INFO(fmt::format("{} {} split {} product {} cdf {} frames {} estimator {} stats {} stored {} optimal weights {}",
                      cs.map, cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, cs.frames, int(config.estimator),
                      config.statsMask, config.sampleCapacity, config.optimalWeights));
@@ -170,12 +164,9 @@ TEST_CASE("pixels that take no samples in a stage are left out of its launch and
         for (int c = 0; c < 3; ++c) nonzero += a.rgb[size_t(p) * 3 + c] != 0;
         for (int k = 0; k < 2 * M; ++k) nonzero += a.moments[size_t(p) * 2 * M + k] != 0;
       }
-      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
-      const std::vector<double> statsA = device.statistics(), statsB = host.statistics();
-      for (size_t i = 0; i < statsA.size(); ++i) mismatches += statsA[i] != statsB[i];
-      const std::vector<float> storedA = device.storedSamples(), storedB = host.storedSamples();
-      for (size_t i = 0; i < storedA.size(); ++i) mismatches += storedA[i] != storedB[i];
+      mismatches += stageMismatches(a, b);
+      mismatches += differingValues(device.statistics(), host.statistics());
+      mismatches += differingValues(device.storedSamples(), host.storedSamples());
       INFO(pdf << ", running sums " << config.statsMask << ", stored samples " << config.sampleCapacity);
       CHECK(nonzero == 0);
       CHECK(mismatches == 0);
@@ -349,10 +340,7 @@ TEST_CASE("resampled sampling on PoCL matches its C++ reference bit for bit", "[
       Sampler device(testDevice(), scene, config);
       HostSampler host(scene, config);
       const StagePlan plan = singleStagePlan(scene, Method::Ris, 50);
-      StageResult a = device.run(plan, 42), b = host.run(plan, 42);
-      size_t mismatches = 0;
-      for (size_t i = 0; i < a.rgb.size(); ++i) mismatches += a.rgb[i] != b.rgb[i];
-      for (size_t i = 0; i < a.moments.size(); ++i) mismatches += a.moments[i] != b.moments[i];
+      const size_t mismatches = stageMismatches(device.run(plan, 42), host.run(plan, 42));
       INFO(fmt::format("{} cdf {}", map, s == EnvmapSampler::Cdf));
       CHECK(mismatches == 0);
     }
