@@ -441,9 +441,9 @@ MA_FN void pixelShareMasses(MA_GLOBAL const float* cells, int count, int s, Pixe
   }
 }
 
-// Pass 3b, for the share columns, while the rows hold each cell's f: per share its
+// Pass 3b, for the share columns, while the rows hold each cell's f: every share's
 // table's mass in each cell, from the table's scales. Only the search reads them.
-MA_FN void pixelOptimalShareScales(MA_GLOBAL const float* cells, int count, MA_LOCAL int* rows, int stride) {
+MA_FN void pixelOptimalShareMasses(MA_GLOBAL const float* cells, int count, MA_LOCAL int* rows, int stride) {
   float plain = chunkTotal(rows, stride, count, CHUNK_PLAIN);
   for (int s = 0; s < MA_MAX_BANK_SHARES; ++s) {
     PixelOptimalTerms t = pixelOptimalTerms(rows, stride, count, columnShare(s));
@@ -486,7 +486,7 @@ MA_FN void buildPixelOptimalCdf(MA_GLOBAL const float* cells, int count, PhongPa
     MA_CELL_LOOP
     for (int j = 0; j < chunksFrom(count, first); ++j)
       addToChunkEq6(count, j, eq6Term(cells, rows, stride, count, first + j, t), rows, stride);
-  if (shareColumns) pixelOptimalShareScales(cells, count, rows, stride);
+  if (shareColumns) pixelOptimalShareMasses(cells, count, rows, stride);
   PixelTableScales s = pixelTableScales(rows, stride, count, t, brdfCovers);
   if (productCdf) {
     ProductCdfTerms p = productCdfTerms(rows, stride, count, brdfCovers);
