@@ -8,10 +8,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <random>
 
 #include "CliRunner.h"
+#include "SafetyWorkspace.h"
 #include "SceneFixtures.h"
 #include "TestDevice.h"
 #include "render/CostCache.h"
@@ -274,11 +274,6 @@ bool sameCosts(const CostModel& a, const CostModel& b) {
         a.launchCount(statistics) != b.launchCount(statistics))
       return false;
   return true;
-}
-
-std::string readText(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "Error.h"
 #include "RawExr.h"
 #include "SceneFixtures.h"
+#include "VectorMath.h"
 #include "scene/GBuffer.h"
 
 using namespace misalloc;
@@ -23,8 +24,6 @@ namespace {
 
 constexpr int kWidth = 8, kHeight = 6;
 const Vec3d kCameraOrigin{1, 2, 3};  // in the map's frame
-
-Vec3d toDouble(const Vec3f& v) { return {v[0], v[1], v[2]}; }
 
 // The renderers' own lat-long lookups, written from their formulas (scene/GBuffer.h
 // cites them): the direction each reads at (u, v).

@@ -16,6 +16,7 @@
 #include "Error.h"
 #include "SceneFixtures.h"
 #include "TestSize.h"
+#include "VectorMath.h"
 #include "render/Render.h"
 #include "sampling/HostSampler.h"
 
@@ -23,12 +24,6 @@ using namespace misalloc;
 using namespace misalloc::test;
 
 namespace {
-
-using Vec3d = std::array<double, 3>;
-
-double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-Vec3d toDouble(const Vec3f& v) { return {v[0], v[1], v[2]}; }
 
 // Two unit vectors that make an orthonormal basis with unit `axis`.
 std::array<Vec3d, 2> basisAbout(const Vec3d& axis) {

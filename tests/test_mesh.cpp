@@ -12,27 +12,20 @@
 #include "CliRunner.h"
 #include "Constants.h"
 #include "Error.h"
+#include "VectorMath.h"
 #include "scene/Mesh.h"
 #include "scene/Scene.h"
 
 using namespace misalloc;
 namespace fs = std::filesystem;
-using misalloc::test::TempDir;
+using namespace misalloc::test;
 
 namespace {
 
-using V3 = std::array<double, 3>;
-
-V3 sub(V3 a, V3 b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-double dot(V3 a, V3 b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-V3 cross(V3 a, V3 b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
-V3 scaled(V3 a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-V3 unit(V3 a) { return scaled(a, 1 / std::sqrt(dot(a, a))); }
-
 // The ray through pixel (x, y)'s centre of a camera at `origin` looking at `target`, image
 // up towards z, vertical field of view `fov` degrees.
-V3 pixelRay(V3 origin, V3 target, double fov, int w, int h, int x, int y) {
-  const V3 f = unit(sub(target, origin)), r = unit(cross(f, {0, 0, 1})), u = cross(r, f);
+Vec3d pixelRay(Vec3d origin, Vec3d target, double fov, int w, int h, int x, int y) {
+  const Vec3d f = unit(sub(target, origin)), r = unit(cross(f, {0, 0, 1})), u = cross(r, f);
   const double ty = std::tan(fov * kPi / 360), tx = ty * w / h;
   const double sx = (2 * (x + 0.5) / w - 1) * tx, sy = (1 - 2 * (y + 0.5) / h) * ty;
   return unit({f[0] + sx * r[0] + sy * u[0], f[1] + sx * r[1] + sy * u[1], f[2] + sx * r[2] + sy * u[2]});
@@ -44,7 +37,7 @@ void writeSphereObj(const std::string& path, int nu, int nv) {
   for (int j = 0; j <= nv; ++j)
     for (int i = 0; i <= nu; ++i) {
       const double t = kPi * j / nv, p = 2 * kPi * i / nu;
-      const V3 v{std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+      const Vec3d v{std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
       f << fmt::format("v {} {} {}\nvn {} {} {}\n", v[0], v[1], v[2], v[0], v[1], v[2]);
     }
   auto corner = [&](int i, int j) { return j * (nu + 1) + i + 1; };
@@ -69,8 +62,8 @@ void writeQuadPly(const std::string& path, int a, int b) {
 }
 
 // The angle between two directions, in radians: by the chord, well conditioned near 0.
-double angleBetween(const Vec3f& a, V3 b) {
-  const V3 d = sub(unit({a[0], a[1], a[2]}), unit(b));
+double angleBetween(const Vec3f& a, Vec3d b) {
+  const Vec3d d = sub(unit({a[0], a[1], a[2]}), unit(b));
   return 2 * std::asin(std::min(1.0, std::sqrt(dot(d, d)) / 2));
 }
 
@@ -80,7 +73,7 @@ TEST_CASE("a tessellated sphere seen by the pinhole camera: its disc and its nor
   TempDir dir("mesh_sphere");
   const std::string obj = (dir.path / "sphere.obj").string();
   writeSphereObj(obj, 96, 48);
-  const V3 origin{4, 1, 1.5}, target{0.1, 0, 0};
+  const Vec3d origin{4, 1, 1.5}, target{0.1, 0, 0};
   const int w = 64, h = 48;
   GBufferOptions camera;
   camera.cameraOrigin = "4,1,1.5";
@@ -91,7 +84,7 @@ TEST_CASE("a tessellated sphere seen by the pinhole camera: its disc and its nor
     for (int x = 0; x < w; ++x) {
       const size_t p = size_t(y) * w + x;
       // The exact sphere along the same ray: |o + t d| = 1.
-      const V3 d = pixelRay(origin, target, 35, w, h, x, y);
+      const Vec3d d = pixelRay(origin, target, 35, w, h, x, y);
       const double b = dot(origin, d), c = dot(origin, origin) - 1, disc = b * b - c;
       const bool hit = disc > 0;
       covered += hit;
@@ -101,7 +94,7 @@ TEST_CASE("a tessellated sphere seen by the pinhole camera: its disc and its nor
       }
       if (!hit) continue;
       const double t = -b - std::sqrt(disc);
-      const V3 normal = {origin[0] + t * d[0], origin[1] + t * d[1], origin[2] + t * d[2]};
+      const Vec3d normal = {origin[0] + t * d[0], origin[1] + t * d[1], origin[2] + t * d[2]};
       // Near the rim a facet's chord misses the sphere's limb: compare where it faces us.
       if (-dot(normal, d) > 0.2) worst = std::max(worst, angleBetween(seen.geometry.pixels[p].normal, normal));
     }

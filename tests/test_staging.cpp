@@ -25,7 +25,7 @@ using namespace misalloc;
 
 namespace {
 
-using Schedule = std::vector<std::vector<int>>;  // per stage, the counts n_k
+using StageCounts = std::vector<std::vector<int>>;  // per stage, the counts n_k
 
 int sampleCount(const std::vector<int>& counts) {
   int n = 0;
@@ -36,7 +36,7 @@ int sampleCount(const std::vector<int>& counts) {
 // The variance of the staged estimate with the pilot (the first stage) weighted
 // `pilotShare` and the stages after it sharing the rest by their sizes; by default
 // every stage weighted N_b/N.
-double stagedVariance(const Example1D& example, const Schedule& schedule, double pilotShare = -1) {
+double stagedVariance(const Example1D& example, const StageCounts& schedule, double pilotShare = -1) {
   int total = 0;
   for (const auto& counts : schedule) total += sampleCount(counts);
   const int pilot = sampleCount(schedule.front());
@@ -57,16 +57,16 @@ std::vector<int> pilotCounts(int techniques, int pilot) {
 }
 
 // What misalloc does: every stage split by α.
-Schedule proportionalSchedule(const std::vector<double>& alpha, int pilot, const std::vector<int>& stages) {
-  Schedule s{pilotCounts(int(alpha.size()), pilot)};
+StageCounts proportionalSchedule(const std::vector<double>& alpha, int pilot, const std::vector<int>& stages) {
+  StageCounts s{pilotCounts(int(alpha.size()), pilot)};
   for (int size : stages) s.push_back(apportionCounts(alpha, size));
   return s;
 }
 
 // The schedule misalloc had before ([HS14] Alg. 1 line 15 read literally): each stage
 // takes the deficits max(0, α_k T − m_k), so that the cumulative counts approach α·T.
-Schedule deficitSchedule(const std::vector<double>& alpha, int pilot, const std::vector<int>& stages) {
-  Schedule s{pilotCounts(int(alpha.size()), pilot)};
+StageCounts deficitSchedule(const std::vector<double>& alpha, int pilot, const std::vector<int>& stages) {
+  StageCounts s{pilotCounts(int(alpha.size()), pilot)};
   std::vector<int> taken = s.front();
   int total = pilot;
   for (int size : stages) {
@@ -116,7 +116,7 @@ TEST_CASE("the pilot's weight from V(equal)/V(alpha) is the best fixed weight of
     Example1D example = paperExample(id);
     std::vector<double> alpha = flooredOptimum(example, 0.01);
     const int pilot = 10 * example.techniqueCount(), total = 200;
-    const Schedule schedule = proportionalSchedule(alpha, pilot, {total - pilot});
+    const StageCounts schedule = proportionalSchedule(alpha, pilot, {total - pilot});
     std::vector<double> split;
     for (int n : schedule.back()) split.push_back(double(n) / (total - pilot));
     const int M = example.techniqueCount();
@@ -143,7 +143,7 @@ TEST_CASE("the staged estimator's variance is the sum of its stages' exact varia
   // [SS23] Example 2 (two Gaussians): a pilot of 4 + 4 and one stage of 32 at α = (0.8, 0.2),
   // combined with weights N_b/N, repeated 20000 times with fixed seeds.
   Example1D example = paperExample("003-2");
-  const Schedule schedule{{4, 4}, {26, 6}};
+  const StageCounts schedule{{4, 4}, {26, 6}};
   std::vector<InverseCdfSampler> samplers;
   for (int k = 0; k < 2; ++k) samplers.emplace_back(example.pdf(k));
   std::mt19937_64 rng(2024);
