@@ -28,12 +28,8 @@ namespace {
 // Two unit vectors that make an orthonormal basis with unit `axis`.
 std::array<Vec3d, 2> basisAbout(const Vec3d& axis) {
   const Vec3d helper = std::abs(axis[0]) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
-  Vec3d t{helper[1] * axis[2] - helper[2] * axis[1], helper[2] * axis[0] - helper[0] * axis[2],
-          helper[0] * axis[1] - helper[1] * axis[0]};
-  const double len = std::sqrt(dot(t, t));
-  for (double& c : t) c /= len;
-  const Vec3d s{axis[1] * t[2] - axis[2] * t[1], axis[2] * t[0] - axis[0] * t[2], axis[0] * t[1] - axis[1] * t[0]};
-  return {t, s};
+  const Vec3d t = unit(cross(helper, axis));
+  return {t, cross(axis, t)};
 }
 
 // ∫ g(ω) dω over the sphere by the midpoint rule on rings about `axis`, with
@@ -80,11 +76,6 @@ struct OffAxisCase {
 std::vector<OffAxisCase> offAxisCases() {
   if (smallTestSize()) return {{{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}};
   return {{{1, 0, 0}, 30, 1}, {{2.0 / 7, -3.0 / 7, 6.0 / 7}, 75, 2}, {{0.6, 0, -0.8}, 45, 0.5}};
-}
-
-Vec3d unitVector(const Vec3d& v) {
-  const double l = std::sqrt(dot(v, v));
-  return {v[0] / l, v[1] / l, v[2] / l};
 }
 
 // Normal `normal` seen from `viewDegrees` off it.
@@ -216,7 +207,7 @@ TEST_CASE("the optimal pdf per pixel is unbiased where quads of pixels share a t
     Scene scene = pixelOptimalOffAxisScene(c, false);
     const Vec3d t = basisAbout(c.normal)[0];
     const Vec3d turned =
-        unitVector({c.normal[0] + 0.026 * t[0], c.normal[1] + 0.026 * t[1], c.normal[2] + 0.026 * t[2]});
+        unit({c.normal[0] + 0.026 * t[0], c.normal[1] + 0.026 * t[1], c.normal[2] + 0.026 * t[2]});
     const PixelFrame even = frameAt(c.normal, c.view), odd = frameAt(turned, c.view);
     for (int p = 1; p < scene.pixelCount(); p += 2) {
       scene.geometry.pixels[size_t(p)] = odd;
