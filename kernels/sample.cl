@@ -32,6 +32,11 @@
 #endif
 
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
+// A multi-sample stage samples each technique in a loop of its own; one-sample, one loop.
+// The loops of the techniques between the first and the last run at least once
+// (docs/pocl.md, rule 12).
+#define TECHNIQUE_LOOPS (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES)
+#define RUNS_AT_LEAST_ONCE(k) ((k) > 0 && (k) + 1 < TECHNIQUE_LOOPS)
 #define SAMPLE_COLUMNS MA_STORED_COLUMNS(MA_TECHNIQUES, MA_SHARE_COLUMNS)
 
 // The per-pixel sums live in local memory, one row per sum (SUM_*, kernels/pixel_layout.h):
@@ -306,7 +311,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
   __local int passCounts[MA_LOCAL_SIZE];
   int start = 0;  // the pass's first sample in the stage
   MA_UNROLL
-  for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
+  for (int k = 0; k < TECHNIQUE_LOOPS; ++k) {
     int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, MA_LOCAL_SIZE, lid)
                           : pixelRows[(ROW_N0 + k) * MA_LOCAL_SIZE + lid];
     passCounts[lid] = n;
@@ -315,7 +320,12 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     MA_UNROLL
     for (int l = 0; l < MA_LOCAL_SIZE; ++l) passSamples = max(passSamples, passCounts[l]);
     barrier(CLK_LOCAL_MEM_FENCE);  // every work-item has read passCounts before the next pass writes it
-    for (int jk = 0; jk < passSamples; ++jk) {
+    // A loop around a barrier that may run no turn makes PoCL copy each later
+    // technique's loop once per way around it (docs/pocl.md, rule 12): a technique
+    // between the first and the last runs at least one turn, uncounted where the
+    // work-group's n are all 0.
+    int jk = 0;
+    if (passSamples > 0 || RUNS_AT_LEAST_ONCE(k)) do {
       SampleContribution c =
           sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width, height,
                         coskExponent, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
@@ -342,7 +352,8 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
       if (MA_STORE_SAMPLES)
         storeSample(samples, c, counted && gid < pixelCount, pixel, firstSlot + j, sampleCapacity, spareSamples, lid);
       barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across pixels
-    }
+      ++jk;
+    } while (jk < passSamples);
     start += n;
   }
   if (gid < pixelCount) {
@@ -464,12 +475,16 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
     if (lid == 0) pixelSums = zeroPixelSums();
     int start = 0;  // the technique's first sample in the stage
     MA_UNROLL
-    for (int k = 0; k < (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES); ++k) {
+    for (int k = 0; k < TECHNIQUE_LOOPS; ++k) {
       int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
                             : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
-      for (int chunk = 0; chunk < n; chunk += CHUNK_SAMPLES) {
-        int passes = min(MA_PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES);
-        for (int p = 0; p < passes; ++p) {
+      // A technique between the first and the last runs at least one pass, uncounted
+      // where n is 0 (the host's LaunchWork counts it), as in sampleStage (rule 12).
+      int chunk = 0;
+      if (n > 0 || RUNS_AT_LEAST_ONCE(k)) do {
+        int passes = max(1, min(MA_PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES));
+        int p = 0;
+        do {
           // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
           int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
           SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
@@ -483,10 +498,12 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
           if (MA_STORE_SAMPLES)
             storeSample(samples, c, jk < n, pixel, firstSlot + start + jk, sampleCapacity, spareSamples, lid);
           barrier(CLK_LOCAL_MEM_FENCE);  // keeps PoCL's work-item loop innermost: vectorised across samples
-        }
+          ++p;
+        } while (p < passes);
         if (lid == 0) addChunk(&pixelSums, terms, min(CHUNK_SAMPLES, n - chunk), k);
         barrier(CLK_LOCAL_MEM_FENCE);
-      }
+        chunk += CHUNK_SAMPLES;
+      } while (chunk < n);
       start += n;
     }
     if (lid == 0) {

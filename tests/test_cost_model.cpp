@@ -68,6 +68,10 @@ TEST_CASE("a launch's work is each work-group's largest count per technique", "[
   // The last group's padding work-items repeat a pixel of the group: no extra work.
   CHECK(launchWork(planOf({{4, 0}, {1, 3}, {2, 2}}), Estimator::MultiSample, 2).slots ==
         std::vector<double>{2 * 2 + 2 * 4, 2 * 3 + 2 * 0});
+  // Of three techniques, a group whose n_1 are all 0 still runs technique 1's loop once;
+  // the first and the last technique's loops run no turn at 0 (docs/pocl.md, rule 12).
+  CHECK(launchWork(planOf({{0, 0, 4}, {3, 0, 1}}), Estimator::MultiSample, 2).slots ==
+        std::vector<double>{2 * 3, 2 * 1, 2 * 4});
 }
 
 TEST_CASE("a launch leaves out the pixels that take no samples", "[costmodel]") {
@@ -147,6 +151,10 @@ TEST_CASE("one pixel per work-group runs each count rounded up to the lanes", "[
   // Lanes of 4: 9 → 12, 7 → 8, 0 → 0, 16 → 16; the group size does not matter.
   const StagePlan plan = planOf({{9, 7}, {0, 16}});
   CHECK(launchWork(plan, Estimator::MultiSample, 8, 4).slots == std::vector<double>{12 + 0, 8 + 16});
+  // A technique between the first and the last runs one pass at 0; a pixel that takes
+  // no samples is not launched.
+  CHECK(launchWork(planOf({{5, 0, 3}, {0, 0, 0}}), Estimator::MultiSample, 8, 4).slots ==
+        std::vector<double>{8, 4, 4});
   // One-sample: N = 16 is a whole pass of lanes, shared by the counts' expectation;
   // N = 5 rounds up to 8.
   CHECK(launchWork(plan, Estimator::OneSample, 8, 4).slots == std::vector<double>{9, 23});

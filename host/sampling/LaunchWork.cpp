@@ -27,20 +27,31 @@ std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range)
   return order;
 }
 
+namespace {
+
+// The turns that technique k's loop runs at the least: 1 between the first technique
+// and the last (kernels/sample.cl, RUNS_AT_LEAST_ONCE; docs/pocl.md, rule 12).
+int leastTurns(int k, int techniqueCount) { return k > 0 && k + 1 < techniqueCount ? 1 : 0; }
+
+}  // namespace
+
 LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize, int pixelLanes) {
   const int M = plan.techniqueCount;
   const int pixels = int(plan.counts.size() / size_t(M));
   LaunchWork work{plan.keepStatistics, std::vector<double>(M, 0.0)};
   if (pixelLanes > 0) {
-    auto roundedUp = [&](int n) { return double((n + pixelLanes - 1) / pixelLanes * pixelLanes); };
+    auto passSlots = [&](int n, int leastPasses) {
+      return double(std::max(leastPasses, (n + pixelLanes - 1) / pixelLanes) * pixelLanes);
+    };
     const bool oneSample = estimator == Estimator::OneSample;
-    for (int p = 0; p < pixels; ++p)
+    for (int p = 0; p < pixels; ++p) {
+      if (!takesSamples(plan, p)) continue;
       for (int k = 0; k < M; ++k) {
         const int n = plan.counts[size_t(p) * M + k];
-        work.slots[k] += oneSample
-                             ? (plan.stageSamples > 0 ? roundedUp(plan.stageSamples) * n / plan.stageSamples : 0.0)
-                             : roundedUp(n);
+        work.slots[k] += oneSample ? passSlots(plan.stageSamples, 1) * n / plan.stageSamples
+                                   : passSlots(n, leastTurns(k, M));
       }
+    }
     return work;
   }
   if (estimator == Estimator::OneSample || groupSize <= 1) {
@@ -52,7 +63,7 @@ LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize,
   const int launched = int(order.size());
   for (int first = 0; first < launched; first += groupSize)
     for (int k = 0; k < M; ++k) {
-      int largest = 0;
+      int largest = leastTurns(k, M);
       for (int i = first; i < std::min(launched, first + groupSize); ++i)
         largest = std::max(largest, int(plan.counts[size_t(order[i]) * M + k]));
       work.slots[k] += double(groupSize) * largest;

@@ -33,9 +33,10 @@ inline bool takesSamples(const StagePlan& plan, int p) {
 
 // What one launch executes: per technique, the sample slots Σ over work-groups of
 // (group size) · (the group's largest n_k), padding work-items included: a work-item
-// whose own n_k is smaller runs the loop too, its surplus samples not counted. The
-// one-sample estimator runs one pass of N samples, each of the technique it draws; its
-// slots are the counts' expectation.
+// whose own n_k is smaller runs the loop too, its surplus samples not counted, and a
+// group whose n_k are all 0 runs it once where k lies between the first technique and
+// the last. The one-sample estimator runs one pass of N samples, each of the technique
+// it draws; its slots are the counts' expectation.
 struct LaunchWork {
   bool keepsStatistics = false;  // the kernel with running sums and stored samples
   std::vector<double> slots;     // [k]
@@ -44,7 +45,8 @@ struct LaunchWork {
 // `groupSize` 1: a sampler that runs each pixel's counts alone (HostSampler).
 // `pixelLanes` > 0: pixels sampled one at a time by a work-group of that many lanes
 // (samplePixelStage), which runs each technique's n_k rounded up to a multiple of the
-// lanes; the one-sample estimator, N rounded up, shared by the counts' expectation.
+// lanes, and one pass of them for n_k = 0 between the first technique and the last;
+// the one-sample estimator, N rounded up, shared by the counts' expectation.
 LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize, int pixelLanes = 0);
 
 }  // namespace misalloc
