@@ -479,7 +479,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
       int n = MA_ONE_SAMPLE ? oneSamplePassSamples(pixelRows, PIXEL_ROW_STRIDE, 0)
                             : pixelRows[(ROW_N0 + k) * PIXEL_ROW_STRIDE];
       // A technique between the first and the last runs at least one pass, uncounted
-      // where n is 0 (the host's LaunchWork counts it), as in sampleStage (rule 12).
+      // where n is 0 (the host's LaunchWork counts it), as in sampleStage (rule 12); a
+      // chunk's passes run at least once, as it holds a sample or is that pass.
       int chunk = 0;
       if (n > 0 || RUNS_AT_LEAST_ONCE(k)) do {
         int passes = max(1, min(MA_PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES));
