@@ -67,6 +67,13 @@ MA_FN int pixelRowCount(int optimalWeights, int techniqueCount, int product, int
   return MA_PIXEL_ROW_COUNT(optimalWeights, techniqueCount, product, pixelCells, productCells, shareColumns);
 }
 
+// The turns that the loop over technique k's samples, of `loops` such loops in a stage
+// (kernels/sample.cl), runs at the least, its count 0 or not: 1 between the first
+// technique and the last, else 0. A loop around a barrier that may run no turn makes
+// PoCL copy each later technique's loops (docs/pocl.md, rule 12); the host's LaunchWork
+// counts the turn.
+MA_FN int techniqueLeastTurns(int k, int loops) { return k > 0 && k + 1 < loops ? 1 : 0; }
+
 // samplePixelStage's chunk of sample terms (kernels/sample.cl): per term, a float for
 // each of MA_PASSES_PER_CHUNK passes of its lanes.
 #define MA_PASSES_PER_CHUNK 8

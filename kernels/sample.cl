@@ -33,10 +33,8 @@
 
 #define STAT_SLOTS (MA_TECHNIQUES * MA_STATS_PER_TECHNIQUE(MA_STATS, MA_TECHNIQUES))
 // A multi-sample stage samples each technique in a loop of its own; one-sample, one loop.
-// The loops of the techniques between the first and the last run at least once
-// (docs/pocl.md, rule 12).
+// Each runs at least techniqueLeastTurns (kernels/pixel_layout.h) turns.
 #define TECHNIQUE_LOOPS (MA_ONE_SAMPLE ? 1 : MA_TECHNIQUES)
-#define RUNS_AT_LEAST_ONCE(k) ((k) > 0 && (k) + 1 < TECHNIQUE_LOOPS)
 #define SAMPLE_COLUMNS MA_STORED_COLUMNS(MA_TECHNIQUES, MA_SHARE_COLUMNS)
 
 // The per-pixel sums live in local memory, one row per sum (SUM_*, kernels/pixel_layout.h):
@@ -325,7 +323,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     // between the first and the last runs at least one turn, uncounted where the
     // work-group's n are all 0.
     int jk = 0;
-    if (passSamples > 0 || RUNS_AT_LEAST_ONCE(k)) do {
+    if (passSamples > 0 || techniqueLeastTurns(k, TECHNIQUE_LOOPS) > 0) do {
       SampleContribution c =
           sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width, height,
                         coskExponent, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
@@ -482,7 +480,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
       // where n is 0 (the host's LaunchWork counts it), as in sampleStage (rule 12); a
       // chunk's passes run at least once, as it holds a sample or is that pass.
       int chunk = 0;
-      if (n > 0 || RUNS_AT_LEAST_ONCE(k)) do {
+      if (n > 0 || techniqueLeastTurns(k, TECHNIQUE_LOOPS) > 0) do {
         int passes = max(1, min(MA_PASSES_PER_CHUNK, (n - chunk + MA_PIXEL_LANES - 1) / MA_PIXEL_LANES));
         int p = 0;
         do {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "KernelCode.h"
+
 namespace misalloc {
 
 std::vector<int32_t> sampledPixels(const StagePlan& plan, PixelRange range) {
@@ -27,14 +29,6 @@ std::vector<int32_t> coherentPixelOrder(const StagePlan& plan, PixelRange range)
   return order;
 }
 
-namespace {
-
-// The turns that technique k's loop runs at the least: 1 between the first technique
-// and the last (kernels/sample.cl, RUNS_AT_LEAST_ONCE; docs/pocl.md, rule 12).
-int leastTurns(int k, int techniqueCount) { return k > 0 && k + 1 < techniqueCount ? 1 : 0; }
-
-}  // namespace
-
 LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize, int pixelLanes) {
   const int M = plan.techniqueCount;
   const int pixels = int(plan.counts.size() / size_t(M));
@@ -49,7 +43,7 @@ LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize,
       for (int k = 0; k < M; ++k) {
         const int n = plan.counts[size_t(p) * M + k];
         work.slots[k] += oneSample ? passSlots(plan.stageSamples, 1) * n / plan.stageSamples
-                                   : passSlots(n, leastTurns(k, M));
+                                   : passSlots(n, kern::techniqueLeastTurns(k, M));
       }
     }
     return work;
@@ -63,7 +57,7 @@ LaunchWork launchWork(const StagePlan& plan, Estimator estimator, int groupSize,
   const int launched = int(order.size());
   for (int first = 0; first < launched; first += groupSize)
     for (int k = 0; k < M; ++k) {
-      int largest = leastTurns(k, M);
+      int largest = kern::techniqueLeastTurns(k, M);
       for (int i = first; i < std::min(launched, first + groupSize); ++i)
         largest = std::max(largest, int(plan.counts[size_t(order[i]) * M + k]));
       work.slots[k] += double(groupSize) * largest;
