@@ -35,10 +35,7 @@ bool closeSums(double a, double b) { return std::abs(a - b) <= 1e-4 * (std::abs(
 // stage's counts. Per-pixel frames (normals and views anywhere, tests/SceneFixtures.h) with the
 // pdfs that allow them, and background pixels among them, which take no samples. A pairwise covering set of map × pdf ×
 // techniques × sampler × frames × sampler configuration (tests/Covering.h); MISALLOC_TEST_SIZE=exhaustive runs every
-// one. The sampler configurations run in groups, one after the other on each case; those whose
-// stages without statistics run the same program (plainConfig) share a group, in which
-// PoCL compiles that program once. The groups make a covering of 11 cases and 28 programs
-// instead of 22 and 35: PoCL's compilation is most of this test's time.
+// one.
 TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bit for bit", "[sampler]") {
   SamplerConfig shareColumns{Estimator::MultiSample, 0, 100, kDefaultGridSize};
   shareColumns.shareColumns = true;  // with the optimal pdf
@@ -52,14 +49,12 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
       shareColumns,
       optimalWeights,
   };
-  // Indices into configs: 0, 3 and 4 share their program without statistics.
-  const std::vector<std::vector<int>> configGroups = {{0, 3, 4}, {1}, {2, 5}};
   struct Case {
     std::string map, pdf;
     int techniques;  // the BRDF as one technique (0), split (1), or with the product (2)
     EnvmapSampler sampler;
     bool frames;  // per-pixel frames with background pixels among them, or the flat scene
-    int group;    // of configGroups
+    int config;
   };
   std::vector<Case> cases;
   std::vector<Configuration> settings;
@@ -68,7 +63,7 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
       for (int techniques : {0, 1, 2})
         for (EnvmapSampler s : {EnvmapSampler::Alias, EnvmapSampler::Cdf})
           for (bool frames : {false, true})
-            for (int group = 0; group < int(configGroups.size()); ++group) {
+            for (int config = 0; config < int(std::size(configs)); ++config) {
               // The optimal pdfs take no split lobes; the one per pixel draws its cells by CDF
               // and its texels by alias tables, whatever the sampler.
               if (techniques == 1 && pdf != "plain") continue;
@@ -79,14 +74,15 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
               // The optimal pdf's bank and the product's tables are built for one frame; with
               // the optimal pdf per pixel the product comes from each pixel's own cells.
               if (frames && (pdf == "optimal" || (techniques == 2 && pdf != "optimal-pixel"))) continue;
-              cases.push_back({map, pdf, techniques, s, frames, group});
+              cases.push_back({map, pdf, techniques, s, frames, config});
               settings.push_back({"map=" + map, "pdf=" + pdf, fmt::format("techniques={}", techniques),
-                                  fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("frames={}", frames)});
-              for (int config : configGroups[size_t(group)]) settings.back().push_back(fmt::format("config={}", config));
+                                  fmt::format("cdf={}", s == EnvmapSampler::Cdf), fmt::format("frames={}", frames),
+                                  fmt::format("config={}", config)});
             }
   const std::vector<size_t> chosen = configurationsToRun(settings);
   for (size_t c : chosen) {
     const Case& cs = cases[c];
+    const SamplerConfig& config = configs[cs.config];
     const bool split = cs.techniques == 1, product = cs.techniques == 2;
     Scene scene = smallScene(cs.map, "seed000", 24, 16, split, cs.sampler, 0, cs.pdf, product);
     if (cs.frames) {
@@ -105,38 +101,35 @@ TEST_CASE("sampleStage and samplePixelStage on PoCL match their C++ reference bi
       if (M == 3) n[1] = 1 + p % 3;
     }
     leaveOutBackground(scene, plan.counts);
-    for (int c : configGroups[size_t(cs.group)]) {
-      const SamplerConfig& config = configs[c];
-      plan.optimalCoefficients.clear();
-      if (config.optimalWeights)
-        for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)
-          plan.optimalCoefficients.push_back(0.02f * float(int(i * 37 % 101) - 50));
-      Sampler device(testDevice(), scene, config);
-      HostSampler host(scene, config);
-      size_t mismatches = 0;
-      // Two stages, so that the running sums and stored samples carry over, and a last
-      // stage without them whose counts span several of samplePixelStage's chunks of
-      // terms. On a CPU with the alias sampler samplePixelStage runs every stage but those
-      // that keep running sums: the stored samples of the share columns' config too.
-      for (int stage = 0; stage < 3; ++stage) {
-        const int scale = stage == 2 ? 3 : 1;
-        StagePlan s = plan;
-        s.keepStatistics = stage < 2;
-        s.stageSamples = 50 * scale;
-        s.samplesBefore = 50 * stage;
-        for (size_t i = 0; i < plan.counts.size(); ++i) {
-          s.counts[i] = plan.counts[i] * scale;
-          s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
-        }
-        mismatches += stageMismatches(device.run(s, 42), host.run(s, 42));
+    plan.optimalCoefficients.clear();
+    if (config.optimalWeights)
+      for (size_t i = 0; i < size_t(scene.pixelCount()) * 3 * M; ++i)
+        plan.optimalCoefficients.push_back(0.02f * float(int(i * 37 % 101) - 50));
+    Sampler device(testDevice(), scene, config);
+    HostSampler host(scene, config);
+    size_t mismatches = 0;
+    // Two stages, so that the running sums and stored samples carry over, and a last
+    // stage without them whose counts span several of samplePixelStage's chunks of
+    // terms. On a CPU with the alias sampler samplePixelStage runs every stage but those
+    // that keep running sums: the stored samples of the share columns' config too.
+    for (int stage = 0; stage < 3; ++stage) {
+      const int scale = stage == 2 ? 3 : 1;
+      StagePlan s = plan;
+      s.keepStatistics = stage < 2;
+      s.stageSamples = 50 * scale;
+      s.samplesBefore = 50 * stage;
+      for (size_t i = 0; i < plan.counts.size(); ++i) {
+        s.counts[i] = plan.counts[i] * scale;
+        s.firstIndex[i] = uint32_t(plan.counts[i] * stage);
       }
-      mismatches += differingValues(device.statistics(), host.statistics());
-      mismatches += differingValues(device.storedSamples(), host.storedSamples());
-      INFO(fmt::format("{} {} split {} product {} cdf {} frames {} estimator {} stats {} stored {} optimal weights {}",
-                       cs.map, cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, cs.frames,
-                       int(config.estimator), config.statsMask, config.sampleCapacity, config.optimalWeights));
-      CHECK(mismatches == 0);
+      mismatches += stageMismatches(device.run(s, 42), host.run(s, 42));
     }
+    mismatches += differingValues(device.statistics(), host.statistics());
+    mismatches += differingValues(device.storedSamples(), host.storedSamples());
+    INFO(fmt::format("{} {} split {} product {} cdf {} frames {} estimator {} stats {} stored {} optimal weights {}",
+                     cs.map, cs.pdf, split, product, cs.sampler == EnvmapSampler::Cdf, cs.frames, int(config.estimator),
+                     config.statsMask, config.sampleCapacity, config.optimalWeights));
+    CHECK(mismatches == 0);
   }
 }
 
