@@ -5,13 +5,13 @@
 // Compile-time options (sampleKernelOptions in host/sampling/Sampler.cpp):
 // MA_TECHNIQUES (M), MA_SPLIT_BRDF, MA_USE_CDF, MA_CDF_STEPS_ROW, MA_CDF_STEPS_COL,
 // MA_ANALYTIC_RADIANCE (1: the map is cos^K θ, K the argument coskExponent, so that every
-// K shares one program; 0: the texels), MA_BANK_SHARES and MA_BANK_BLOCK_LOG2 (the optimal pdf's
-// bank, kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
+// K shares one program; 0: the texels), MA_BANK_SHARES (the optimal pdf's bank,
+// kernels/envmap.h; 0: none), MA_ONE_SAMPLE, MA_COUNT_INDEPENDENT, MA_RIS_CANDIDATES
 // (> 0: technique 0 resamples that many envmap candidates, kernels/ris.h),
 // MA_PRODUCT_TABLES, MA_PRODUCT_BLOCK_LOG2 and MA_PRODUCT_PLAIN_TEXELS (the product
 // technique's tables, kernels/product.h; 0: none), MA_PIXEL_CELLS and MA_PIXEL_CDF_STEPS
-// (the optimal pdf per pixel over that many blocks of 2^MA_BANK_BLOCK_LOG2 texels,
-// kernels/pixel_optimal.h; 0: none), MA_PRODUCT_CELLS (1: the product technique from
+// (the optimal pdf per pixel over that many blocks of texels, kernels/pixel_optimal.h;
+// 0: none), MA_PRODUCT_CELLS (1: the product technique from
 // those cells, kernels/product.h), MA_STATS (the
 // running sums kept, kernels/stats.h), MA_STORE_SAMPLES, MA_SHARE_COLUMNS (the stored
 // samples' share columns, kernels/stats.h; 0: none), MA_OPTIMAL_WEIGHTS ([Kon19]'s
@@ -175,8 +175,9 @@ MA_FN MaFrame frameOfRows(__local const int* pixelRows, int rowStride, int colum
 MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global const float* cdfTable,
                                        __global const uint* aliasTable, __global const float* blockProbs,
                                        __global const float* productFloats, __global const uint* productWords,
-                                       int width, int height, float coskExponent, __local const int* pixelRows,
-                                       int rowStride, int column, __local const int* cdfRows, int cdfStride,
+                                       int width, int height, float coskExponent, int blockLog2,
+                                       __local const int* pixelRows, int rowStride, int column,
+                                       __local const int* cdfRows, int cdfStride,
                                        int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
                                        int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
@@ -191,7 +192,7 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
   env.cdfStepsCol = MA_CDF_STEPS_COL;
   env.coskExponent = MA_ANALYTIC_RADIANCE ? coskExponent : -1.0f;
   env.bankShares = MA_BANK_SHARES;
-  env.blockLog2 = MA_BANK_BLOCK_LOG2;
+  env.blockLog2 = blockLog2;
   env.blockProbs = blockProbs;
   env.brdfBin = (int)as_float(PIXEL_ROW(ROW_BRDF_BIN));
   env.bankEntry = 0;
@@ -270,10 +271,13 @@ MA_FN void storeSample(__global float* samples, SampleContribution c, int kept, 
 #define MA_OPTIONAL_PARAMETERS
 #define MA_COEFFICIENTS ((__global const float*)0)
 #endif
+// blockLog2: the bank's and the per-pixel cells' blocks are 2^blockLog2 texels across,
+// a shift of the map's size: an argument, so that maps of every size share a program.
 #define MA_SAMPLE_STAGE_PARAMETERS                                                                                 \
   __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                   \
       __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,    \
-      int width, int height, float coskExponent, __global const float *shadingPoints, __global const int *counts,  \
+      int width, int height, float coskExponent, int blockLog2, __global const float *shadingPoints,                \
+      __global const int *counts,                                                                                  \
       __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixelCount, \
       int imageWidth, __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments,             \
       __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
@@ -326,7 +330,7 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     if (passSamples > 0 || techniqueLeastTurns(k, TECHNIQUE_LOOPS) > 0) do {
       SampleContribution c =
           sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width, height,
-                        coskExponent, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
+                        coskExponent, blockLog2, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
                         MA_LOCAL_SIZE, stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
@@ -487,7 +491,7 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
           // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
           int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
           SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                               width, height, coskExponent, pixelRows, PIXEL_ROW_STRIDE, 0, cdfRows, 1,
+                                               width, height, coskExponent, blockLog2, pixelRows, PIXEL_ROW_STRIDE, 0, cdfRows, 1,
                                                stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
           terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
           terms[TERM_G * CHUNK_SAMPLES + t] = c.g;

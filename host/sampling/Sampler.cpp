@@ -60,19 +60,19 @@ std::string sampleKernelOptions(const Scene& scene, const SamplerConfig& config,
   const EnvmapTables& t = stageTables(scene, keepsStatistics(config));
   return fmt::format(
       "-cl-std=CL1.2 -DMA_TECHNIQUES={} -DMA_SPLIT_BRDF={} -DMA_USE_CDF={} -DMA_CDF_STEPS_ROW={} "
-      "-DMA_CDF_STEPS_COL={} -DMA_ANALYTIC_RADIANCE={} -DMA_BANK_SHARES={} -DMA_BANK_BLOCK_LOG2={} "
+      "-DMA_CDF_STEPS_COL={} -DMA_ANALYTIC_RADIANCE={} -DMA_BANK_SHARES={} "
       "-DMA_ONE_SAMPLE={} -DMA_COUNT_INDEPENDENT={} -DMA_RIS_CANDIDATES={} -DMA_STATS={} -DMA_STORE_SAMPLES={} "
       "-DMA_SHARE_COLUMNS={} -DMA_OPTIMAL_WEIGHTS={} -DMA_PRODUCT_TABLES={} -DMA_PRODUCT_BLOCK_LOG2={} "
       "-DMA_PRODUCT_PLAIN_TEXELS={} -DMA_PRODUCT_CELLS={} -DMA_PIXEL_CELLS={} -DMA_PIXEL_CDF_STEPS={} "
       "-DMA_LOCAL_SIZE={} -DMA_PIXEL_LANES={} -DMA_GROUP_PIXELS={} "
       "-DMA_SPLIT_LOAD64={}",
       scene.techniqueCount(), scene.options.splitBrdf ? 1 : 0, t.useCdf ? 1 : 0, t.cdfStepsRow, t.cdfStepsCol,
-      scene.envmap.coskExponent >= 0 ? 1 : 0, t.bankShares, t.blockLog2,
-      config.estimator == Estimator::OneSample ? 1 : 0, config.estimator == Estimator::CountIndependent ? 1 : 0,
-      config.risCandidates, config.statsMask, config.sampleCapacity > 0 ? 1 : 0,
-      sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0, scene.productTables.tables,
-      scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0, scene.productTables.pixelCells ? 1 : 0,
-      t.pixelCells, t.pixelCdfSteps, localSize, pixelLanes, groupPixels, pixelLanes > 0 ? 1 : 0);
+      scene.envmap.coskExponent >= 0 ? 1 : 0, t.bankShares, config.estimator == Estimator::OneSample ? 1 : 0,
+      config.estimator == Estimator::CountIndependent ? 1 : 0, config.risCandidates, config.statsMask,
+      config.sampleCapacity > 0 ? 1 : 0, sampleColumns(scene, config).shareColumns, config.optimalWeights ? 1 : 0,
+      scene.productTables.tables, scene.productTables.blockLog2, scene.productTables.plainTexels ? 1 : 0,
+      scene.productTables.pixelCells ? 1 : 0, t.pixelCells, t.pixelCdfSteps, localSize, pixelLanes, groupPixels,
+      pixelLanes > 0 ? 1 : 0);
 }
 
 int samplePixelLanes(const Scene& scene, const SamplerConfig& config, int deviceLanes) {
@@ -239,10 +239,11 @@ StageResult Sampler::runOrder(const StagePlan& plan, uint64_t seed, int firstSlo
       bindKernelArgs(kernel, args...);
   };
   bind(env.texels, env.cdfTable, env.aliasTable, env.blockProbs, b.productFloats, b.productWords,
-       cl_int(scene_.tables.width), cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent), b.shadingPoints,
-       counts_, firstIndex_, cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32),
-       cl_int(scene_.firstPixel), cl_int(order.size()), cl_int(scene_.grid.width), pixelOrder_, rgb_, moments_,
-       stats_, samples_, cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
+       cl_int(scene_.tables.width), cl_int(scene_.tables.height), cl_float(scene_.envmap.coskExponent),
+       cl_int(stageTables(scene_, statistics).blockLog2), b.shadingPoints, counts_, firstIndex_,
+       cl_int(plan.stageSamples), cl_uint(seed & 0xffffffffu), cl_uint(seed >> 32), cl_int(scene_.firstPixel),
+       cl_int(order.size()), cl_int(scene_.grid.width), pixelOrder_, rgb_, moments_, stats_, samples_,
+       cl_int(firstSlot), cl_int(config_.sampleCapacity), cl_int(storedSampleCount()));
   const int lanes = pixelLanes(statistics);
   const size_t local = lanes > 0 ? size_t(lanes) : size_t(localSize_);
   const size_t groups = lanes > 0 ? (order.size() + size_t(groupPixels_) - 1) / size_t(groupPixels_) : 0;
