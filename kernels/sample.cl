@@ -330,8 +330,9 @@ __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleS
     if (passSamples > 0 || techniqueLeastTurns(k, TECHNIQUE_LOOPS) > 0) do {
       SampleContribution c =
           sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords, width, height,
-                        coskExponent, blockLog2, pixelRows, MA_LOCAL_SIZE, lid, pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid,
-                        MA_LOCAL_SIZE, stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+                        coskExponent, blockLog2, pixelRows, MA_LOCAL_SIZE, lid,
+                        pixelRows + ROW_PIXEL_CDF * MA_LOCAL_SIZE + lid, MA_LOCAL_SIZE, stageSamples, seedLo, seedHi,
+                        firstPixel, pixel, k, jk);
       int counted = jk < n, j = start + jk;
       ma_acc w = counted ? (ma_acc)c.w : 0, ww = w * w;
       sums[SUM_R][lid] += counted ? (ma_acc)c.r : 0;
@@ -491,8 +492,8 @@ __kernel __attribute__((reqd_work_group_size(MA_PIXEL_LANES, 1, 1))) void sample
           // (pL) xor l is pL + l: written so, LLVM cannot make it a 64-bit induction variable.
           int t = (p * MA_PIXEL_LANES) ^ lid, jk = chunk + t;
           SampleContribution c = sampleOfPixel(texels, cdfTable, aliasTable, blockProbs, productFloats, productWords,
-                                               width, height, coskExponent, blockLog2, pixelRows, PIXEL_ROW_STRIDE, 0, cdfRows, 1,
-                                               stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
+                                               width, height, coskExponent, blockLog2, pixelRows, PIXEL_ROW_STRIDE, 0,
+                                               cdfRows, 1, stageSamples, seedLo, seedHi, firstPixel, pixel, k, jk);
           terms[TERM_R * CHUNK_SAMPLES + t] = c.r;
           terms[TERM_G * CHUNK_SAMPLES + t] = c.g;
           terms[TERM_B * CHUNK_SAMPLES + t] = c.b;
