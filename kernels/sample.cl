@@ -177,9 +177,8 @@ MA_FN SampleContribution sampleOfPixel(__global const float* texels, __global co
                                        __global const float* productFloats, __global const uint* productWords,
                                        int width, int height, float coskExponent, int blockLog2,
                                        __local const int* pixelRows, int rowStride, int column,
-                                       __local const int* cdfRows, int cdfStride,
-                                       int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixel,
-                                       int technique, int j) {
+                                       __local const int* cdfRows, int cdfStride, int stageSamples, uint seedLo,
+                                       uint seedHi, int firstPixel, int pixel, int technique, int j) {
 #define PIXEL_ROW(row) pixelRows[(row)*rowStride + column]
   EnvmapView env;
   env.texels = texels;
@@ -273,14 +272,14 @@ MA_FN void storeSample(__global float* samples, SampleContribution c, int kept, 
 #endif
 // blockLog2: the bank's and the per-pixel cells' blocks are 2^blockLog2 texels across,
 // a shift of the map's size: an argument, so that maps of every size share a program.
-#define MA_SAMPLE_STAGE_PARAMETERS                                                                                 \
-  __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                   \
-      __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,    \
+#define MA_SAMPLE_STAGE_PARAMETERS                                                                                  \
+  __global const float *texels, __global const float *cdfTable, __global const uint *aliasTable,                    \
+      __global const float *blockProbs, __global const float *productFloats, __global const uint *productWords,     \
       int width, int height, float coskExponent, int blockLog2, __global const float *shadingPoints,                \
-      __global const int *counts,                                                                                  \
-      __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi, int firstPixel, int pixelCount, \
-      int imageWidth, __global const int *pixelOrder, __global ma_acc *estimate, __global ma_acc *moments,             \
-      __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, int spareSamples MA_OPTIONAL_PARAMETERS
+      __global const int *counts, __global const uint *firstIndex, int stageSamples, uint seedLo, uint seedHi,      \
+      int firstPixel, int pixelCount, int imageWidth, __global const int *pixelOrder, __global ma_acc *estimate,    \
+      __global ma_acc *moments, __global ma_acc *stats, __global float *samples, int firstSlot, int sampleCapacity, \
+      int spareSamples MA_OPTIONAL_PARAMETERS
 
 __kernel __attribute__((reqd_work_group_size(MA_LOCAL_SIZE, 1, 1))) void sampleStage(MA_SAMPLE_STAGE_PARAMETERS) {
   __local ma_acc sums[SUM_COUNT][MA_LOCAL_SIZE];
